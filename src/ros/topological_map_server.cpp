@@ -1,0 +1,43 @@
+#include "picker_localisation/ros/topological_map_server.h"
+
+#include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/topology/map_io.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string map_file, frame_id;
+  double node_scale = 0.35;
+  bool labels = true;
+  if (!pnh.getParam("map_file", map_file) || map_file.empty()) {
+    ROS_FATAL("topological_map_server: parameter ~map_file is required (a tmap2 or legacy tmap file)");
+    return;
+  }
+  pnh.param<std::string>("frame_id", frame_id, "map");
+  pnh.param("node_scale", node_scale, node_scale);
+  pnh.param("labels", labels, labels);
+  try {
+    const topology::TopologicalMap map = topology::loadMap(map_file);
+    msg_ = toMsg(map, frame_id);
+    msg_.header.stamp = ros::Time::now();
+    map_pub_ = nh.advertise<picker_localisation::TopologicalMap>("topological_map", 1, /*latch=*/true);
+    marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("topological_map/markers", 1, /*latch=*/true);
+    service_ = nh.advertiseService("get_topological_map", &TopologicalMapServer::serveMap, this);
+    map_pub_.publish(msg_);
+    marker_pub_.publish(mapMarkers(map, frame_id, node_scale, labels));
+    ROS_INFO("topological_map_server: '%s' from %s: %zu nodes, %zu directed edges, %zu lanes", map.name().c_str(),
+             map_file.c_str(), map.numNodes(), map.numDirectedEdges(), map.numLanes());
+    ok_ = true;
+  } catch (const topology::MapError& e) {
+    ROS_FATAL("topological_map_server: %s", e.what());
+  }
+}
+
+bool TopologicalMapServer::serveMap(GetTopologicalMap::Request&, GetTopologicalMap::Response& res) {
+  res.map = msg_;
+  return true;
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,188 @@
+#include "picker_localisation/topology/map_io.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace picker_localisation {
+namespace topology {
+
+namespace {
+
+class MapReader {
+ public:
+  explicit MapReader(std::string source) : source_(std::move(source)) {}
+
+  TopologicalMap read(const YAML::Node& root, MapFormat format) {
+    if (!root || root.IsNull()) throw MapError(source_, "the file is empty");
+    if (format == MapFormat::kAuto) {
+      if (root.IsMap() && root["nodes"]) {
+        format = MapFormat::kTmap2;
+      } else if (root.IsSequence()) {
+        format = MapFormat::kLegacyTmap;
+      } else {
+        throw MapError(source_,
+                       "not a topological map: the top level must be a mapping with a 'nodes' list (tmap2) or a "
+                       "list of {meta, node} entries (legacy tmap)");
+      }
+    }
+    const YAML::Node* list = &root;
+    std::string name, metric_map;
+    if (format == MapFormat::kTmap2) {
+      if (!root.IsMap()) throw MapError(source_, "tmap2: the top level must be a mapping");
+      if (!root["nodes"] || !root["nodes"].IsSequence())
+        throw MapError(source_, "tmap2: 'nodes' must be a list", "", "nodes");
+      list = &nodes_holder_;
+      nodes_holder_ = root["nodes"];
+      name = scalarOr(root["name"], "");
+      metric_map = scalarOr(root["metric_map"], "");
+    } else if (!root.IsSequence()) {
+      throw MapError(source_, "legacy tmap: the top level must be a list of {meta, node} entries");
+    }
+
+    std::vector<Node> nodes;
+    std::vector<EdgeSpec> edges;
+    std::size_t i = 0;
+    for (const YAML::Node& entry : *list) {
+      readEntry(entry, i++, nodes, edges, metric_map, name);
+    }
+    return TopologicalMap::build(name, std::move(nodes), edges, source_, metric_map);
+  }
+
+ private:
+  static std::string scalarOr(const YAML::Node& n, const std::string& fallback) {
+    return n && n.IsScalar() ? n.as<std::string>() : fallback;
+  }
+
+  double number(const YAML::Node& parent, const char* key, const std::string& node, const std::string& path,
+                bool required, double fallback = 0.0) {
+    const YAML::Node v = parent[key];
+    if (!v || v.IsNull()) {
+      if (required) throw MapError(source_, "missing field", node, path);
+      return fallback;
+    }
+    if (!v.IsScalar()) throw MapError(source_, "expected a number", node, path);
+    const std::string text = v.Scalar();
+    std::string lower;
+    for (char c : text) lower.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(c))));
+    if (lower == ".nan" || lower == ".inf" || lower == "-.inf" || lower == "+.inf")  // YAML's special floats
+      throw MapError(source_, "number is not finite: '" + text + "'", node, path);
+    try {
+      std::size_t used = 0;
+      double d = std::stod(text, &used);
+      if (used != text.size()) throw std::invalid_argument(text);
+      if (!std::isfinite(d)) throw MapError(source_, "number is not finite: '" + text + "'", node, path);
+      return d;
+    } catch (const std::logic_error&) {
+      throw MapError(source_, "not a number: '" + text + "'", node, path);
+    }
+  }
+
+  void readEntry(const YAML::Node& entry, std::size_t i, std::vector<Node>& nodes, std::vector<EdgeSpec>& edges,
+                 std::string& metric_map, std::string& name) {
+    const std::string where = "nodes[" + std::to_string(i) + "]";
+    if (!entry.IsMap()) throw MapError(source_, where + " is not a mapping", "", "nodes");
+    const YAML::Node body = entry["node"];
+    if (!body || !body.IsMap()) throw MapError(source_, where + " has no 'node' mapping", "", "node");
+    Node n;
+    const YAML::Node name_node = body["name"];
+    if (!name_node || !name_node.IsScalar() || name_node.Scalar().empty()) {
+      // Fall back to meta.node, which both formats carry.
+      const YAML::Node meta_name = entry["meta"] ? entry["meta"]["node"] : YAML::Node();
+      if (!meta_name || !meta_name.IsScalar()) throw MapError(source_, where + " has no name", "", "node.name");
+      n.name = meta_name.Scalar();
+    } else {
+      n.name = name_node.Scalar();
+    }
+    const YAML::Node pose = body["pose"];
+    if (!pose || !pose.IsMap()) throw MapError(source_, "missing pose", n.name, "node.pose");
+    const YAML::Node position = pose["position"];
+    if (!position || !position.IsMap()) throw MapError(source_, "missing position", n.name, "node.pose.position");
+    n.position.x() = number(position, "x", n.name, "node.pose.position.x", true);
+    n.position.y() = number(position, "y", n.name, "node.pose.position.y", true);
+    n.position.z() = number(position, "z", n.name, "node.pose.position.z", false);
+    const YAML::Node orientation = pose["orientation"];
+    if (orientation && orientation.IsMap()) {
+      n.orientation[0] = number(orientation, "x", n.name, "node.pose.orientation.x", false);
+      n.orientation[1] = number(orientation, "y", n.name, "node.pose.orientation.y", false);
+      n.orientation[2] = number(orientation, "z", n.name, "node.pose.orientation.z", false);
+      n.orientation[3] = number(orientation, "w", n.name, "node.pose.orientation.w", false, 1.0);
+      double norm = std::sqrt(n.orientation[0] * n.orientation[0] + n.orientation[1] * n.orientation[1] +
+                              n.orientation[2] * n.orientation[2] + n.orientation[3] * n.orientation[3]);
+      if (norm < 1e-9) {
+        n.orientation = {0.0, 0.0, 0.0, 1.0};
+      } else {
+        for (double& c : n.orientation) c /= norm;
+      }
+    }
+    // Tags: meta.tag (tmap2 with tags) or node.tag; a scalar or a list.
+    for (const YAML::Node& holder : {entry["meta"], body}) {
+      if (!holder || !holder.IsMap() || !holder["tag"]) continue;
+      const YAML::Node tags = holder["tag"];
+      if (tags.IsScalar()) {
+        n.tags.push_back(tags.Scalar());
+      } else if (tags.IsSequence()) {
+        for (const YAML::Node& t : tags)
+          if (t.IsScalar()) n.tags.push_back(t.Scalar());
+      }
+    }
+    if (metric_map.empty()) metric_map = scalarOr(body["map"], scalarOr(entry["meta"] ? entry["meta"]["map"] : YAML::Node(), ""));
+    if (name.empty()) name = scalarOr(entry["meta"] ? entry["meta"]["pointset"] : YAML::Node(), scalarOr(body["pointset"], ""));
+
+    const YAML::Node edge_list = body["edges"];
+    if (edge_list && !edge_list.IsNull()) {
+      if (!edge_list.IsSequence()) throw MapError(source_, "'edges' must be a list", n.name, "node.edges");
+      std::size_t k = 0;
+      for (const YAML::Node& e : edge_list) {
+        const std::string field = "node.edges[" + std::to_string(k++) + "]";
+        if (!e.IsMap()) throw MapError(source_, "edge is not a mapping", n.name, field);
+        const YAML::Node target = e["node"];
+        if (!target || !target.IsScalar() || target.Scalar().empty())
+          throw MapError(source_, "edge has no target node", n.name, field + ".node");
+        EdgeSpec spec;
+        spec.source = n.name;
+        spec.target = target.Scalar();
+        spec.id = scalarOr(e["edge_id"], n.name + "_" + spec.target);
+        spec.action = scalarOr(e["action"], "");
+        edges.push_back(spec);
+      }
+    }
+    nodes.push_back(std::move(n));
+  }
+
+  std::string source_;
+  YAML::Node nodes_holder_;
+};
+
+}  // namespace
+
+TopologicalMap parseMap(const std::string& text, const std::string& source, MapFormat format) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw MapError(source, "YAML syntax error at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  try {
+    return MapReader(source).read(root, format);
+  } catch (const MapError&) {
+    throw;
+  } catch (const YAML::Exception& e) {
+    throw MapError(source, std::string("unexpected YAML structure: ") + e.msg);
+  }
+}
+
+TopologicalMap loadMap(const std::string& path, MapFormat format) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw MapError(path, "cannot open the file for reading");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) throw MapError(path, "cannot read the file");
+  return parseMap(buffer.str(), path, format);
+}
+
+}  // namespace topology
+}  // namespace picker_localisation

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# tmap_info: exact counts on the shipped maps; one error line and exit status 2 on malformed files.
+set -u
+bin="$1"; pkg="$2"; shared="$pkg/../shared/data/topomaps"
+fail=0
+check() { # file key expected
+  got="$("$bin" "$1" | sed -n "s/^$2: //p")"
+  if [ "$got" != "$3" ]; then echo "FAIL: $1 $2: got '$got', want '$3'"; fail=1; else echo "ok: $(basename "$1") $2 = $3"; fi
+}
+check "$pkg/config/maps/riseholme.tmap2" nodes 138
+check "$pkg/config/maps/riseholme.tmap2" directed_edges 308
+check "$pkg/config/maps/riseholme.tmap2" undirected_edges 154
+check "$pkg/config/maps/riseholme.tmap2" lanes 12
+check "$pkg/config/maps/riseholme.tmap2" components 1
+"$bin" "$pkg/config/maps/riseholme.tmap2" | grep -q '^bbox: \[12\.4[0-9]*, -37\.[0-9]*, 31\.[45][0-9]*, 3\.0[0-9]*\]' \
+  || { echo "FAIL: bbox line"; "$bin" "$pkg/config/maps/riseholme.tmap2"; fail=1; }
+if [ -f "$shared/riseholme_sim.tmap" ]; then
+  check "$shared/riseholme_sim.tmap" nodes 131
+  check "$shared/riseholme_sim.tmap" directed_edges 208
+fi
+tmp="$(mktemp -d)"; trap 'rm -rf "$tmp"' EXIT
+printf 'nodes:\n- node: {name: A, pose: {position: {x: 0, y: 0}}, edges: [{edge_id: A_B, node: B}]}\n' > "$tmp/missing_target.tmap2"
+printf 'nodes:\n- node: {name: A, pose: {position: {x: oops, y: 0}}}\n' > "$tmp/bad_number.tmap2"
+: > "$tmp/empty.tmap2"
+printf '42\n' > "$tmp/scalar.tmap2"
+for f in missing_target bad_number empty scalar nonexistent; do
+  out="$("$bin" "$tmp/$f.tmap2" 2>&1 >/dev/null)"; rc=$?
+  lines="$(printf '%s\n' "$out" | grep -c .)"
+  if [ $rc -ne 2 ] || [ "$lines" -ne 1 ] || ! printf '%s' "$out" | grep -q "$tmp/$f.tmap2"; then
+    echo "FAIL: $f: rc=$rc lines=$lines out='$out'"; fail=1
+  else
+    echo "ok: $f -> rc 2: $out"
+  fi
+done
+printf '%s\n' "$("$bin" "$tmp/missing_target.tmap2" 2>&1)" | grep -q "node 'A'" || { echo "FAIL: node name missing"; fail=1; }
+printf '%s\n' "$("$bin" "$tmp/bad_number.tmap2" 2>&1)" | grep -q "node.pose.position.x" || { echo "FAIL: field missing"; fail=1; }
+exit $fail

@@ -1,0 +1,52 @@
+// Map <-> message round trip and the map's markers (no roscore needed).
+#include <gtest/gtest.h>
+
+#include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/topology/map_io.h"
+
+using namespace picker_localisation;
+
+TEST(MapConversions, RoundTripKeepsNodesEdgesAndLanes) {
+  topology::TopologicalMap map = topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  picker_localisation::TopologicalMap msg = ros_adapter::toMsg(map, "map");
+  EXPECT_EQ(msg.header.frame_id, "map");
+  ASSERT_EQ(msg.nodes.size(), 138u);
+  ASSERT_EQ(msg.edges.size(), 308u);
+  EXPECT_EQ(msg.lanes.size(), 12u);
+  topology::TopologicalMap back = ros_adapter::fromMsg(msg);
+  EXPECT_EQ(back.numNodes(), map.numNodes());
+  EXPECT_EQ(back.numDirectedEdges(), map.numDirectedEdges());
+  EXPECT_EQ(back.numLanes(), map.numLanes());
+  for (topology::NodeIndex i = 0; i < map.numNodes(); ++i) {
+    EXPECT_EQ(back.node(i).name, map.node(i).name);
+    EXPECT_EQ(back.laneNameOf(i), map.laneNameOf(i));
+    EXPECT_DOUBLE_EQ(back.node(i).position.x(), map.node(i).position.x());
+  }
+}
+
+TEST(MapConversions, BadEdgeIndexIsAnError) {
+  picker_localisation::TopologicalMap msg;
+  msg.nodes.resize(1);
+  msg.nodes[0].name = "a";
+  msg.edges.resize(1);
+  msg.edges[0].source = 0;
+  msg.edges[0].target = 7;
+  EXPECT_THROW(ros_adapter::fromMsg(msg), topology::MapError);
+}
+
+TEST(MapConversions, MarkersCoverNodesEdgesLabels) {
+  topology::TopologicalMap map = topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  visualization_msgs::MarkerArray m = ros_adapter::mapMarkers(map, "map");
+  ASSERT_EQ(m.markers.size(), 2u + 138u);
+  EXPECT_EQ(m.markers[0].ns, "nodes");
+  EXPECT_EQ(m.markers[0].points.size(), 138u);
+  EXPECT_EQ(m.markers[0].colors.size(), 138u);
+  EXPECT_EQ(m.markers[1].ns, "edges");
+  EXPECT_EQ(m.markers[1].points.size(), 2u * 154u);
+  EXPECT_EQ(m.markers[2].ns, "labels");
+  EXPECT_EQ(m.markers[2].text, map.node(0).name);
+  // Lane colours: two different lanes differ; no-lane is grey.
+  auto c0 = ros_adapter::laneColour(0), c1 = ros_adapter::laneColour(1), none = ros_adapter::laneColour(-1);
+  EXPECT_TRUE(c0.r != c1.r || c0.g != c1.g || c0.b != c1.b);
+  EXPECT_FLOAT_EQ(none.r, none.g);
+}

@@ -1,0 +1,283 @@
+// Topology core: both loaders on the real Riseholme maps, malformed inputs, every query.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "picker_localisation/topology/map_io.h"
+#include "picker_localisation/topology/synthetic_map.h"
+
+using namespace picker_localisation::topology;
+
+namespace {
+const std::string kTmap2 = std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2";
+const std::string kLegacy = std::string(PL_SHARED_DATA) + "/topomaps/riseholme_sim.tmap";
+const std::string kSharedTmap2 = std::string(PL_SHARED_DATA) + "/topomaps/riseholme.tmap2";
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseMap(text, "bad.tmap2");
+  } catch (const MapError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Linear-scan reference for the k-d tree.
+NodeIndex bruteNearest(const TopologicalMap& m, const Eigen::Vector2d& p) {
+  NodeIndex best = 0;
+  for (NodeIndex i = 1; i < m.numNodes(); ++i)
+    if ((m.position2d(i) - p).norm() < (m.position2d(best) - p).norm()) best = i;
+  return best;
+}
+}  // namespace
+
+TEST(Tmap2Loader, RiseholmeCounts) {
+  TopologicalMap m = loadMap(kTmap2);
+  EXPECT_EQ(m.numNodes(), 138u);
+  EXPECT_EQ(m.numDirectedEdges(), 308u);
+  EXPECT_EQ(m.numUndirectedEdges(), 154u);  // all bidirectional (data README)
+  EXPECT_EQ(m.name(), "riseholme_rtk");
+  EXPECT_EQ(m.metricMap(), "riseholme");
+  EXPECT_EQ(m.numComponents(), 1u);
+  // README bbox: x in [12.4, 31.5], y in [-37.8, 3.0].
+  BoundingBox b = m.boundingBox();
+  EXPECT_NEAR(b.min_x, 12.4, 0.05);
+  EXPECT_NEAR(b.max_x, 31.5, 0.05);
+  EXPECT_NEAR(b.min_y, -37.8, 0.05);
+  EXPECT_NEAR(b.max_y, 3.0, 0.05);
+  // Values read from the file text: WayPoint1 at (14.3593025208, -20.0007381439), edges to WayPoint2, WayPoint5.
+  NodeIndex w1 = *m.index("WayPoint1");
+  EXPECT_DOUBLE_EQ(m.node(w1).position.x(), 14.3593025208);
+  EXPECT_DOUBLE_EQ(m.node(w1).position.y(), -20.0007381439);
+  std::set<std::string> succ;
+  for (NodeIndex s : m.successors(w1)) succ.insert(m.node(s).name);
+  EXPECT_EQ(succ, (std::set<std::string>{"WayPoint2", "WayPoint5"}));
+}
+
+TEST(Tmap2Loader, ShippedCopyMatchesSharedData) {
+  TopologicalMap a = loadMap(kTmap2), b = loadMap(kSharedTmap2);
+  ASSERT_EQ(a.numNodes(), b.numNodes());
+  for (NodeIndex i = 0; i < a.numNodes(); ++i) EXPECT_EQ(a.node(i).name, b.node(i).name);
+}
+
+TEST(LegacyLoader, RiseholmeSimCounts) {
+  TopologicalMap m = loadMap(kLegacy);
+  EXPECT_EQ(m.numNodes(), 131u);
+  EXPECT_EQ(m.numDirectedEdges(), 208u);
+  EXPECT_EQ(m.metricMap(), "riseholme_sim");
+  EXPECT_EQ(m.name(), "riseholme_sim");
+  // Direction is kept as in the file: WayPoint1 -> WayPoint2 only.
+  NodeIndex w1 = *m.index("WayPoint1"), w2 = *m.index("WayPoint2");
+  EXPECT_EQ(m.successors(w1), std::vector<NodeIndex>{w2});
+  EXPECT_TRUE(m.connected(w2, w1));  // but the motion graph is undirected
+  EXPECT_DOUBLE_EQ(m.node(w1).position.x(), 14.35);
+  EXPECT_DOUBLE_EQ(m.node(w1).position.y(), -7.2845);
+  // Many edges are one-way, so the undirected graph has fewer pairs than twice the directed edges.
+  EXPECT_LT(m.numUndirectedEdges() * 2, m.numDirectedEdges() * 2);
+  EXPECT_GE(m.numUndirectedEdges(), m.numDirectedEdges() / 2);
+}
+
+TEST(LegacyLoader, ExplicitFormatMismatchIsAnError) {
+  EXPECT_THROW(loadMap(kLegacy, MapFormat::kTmap2), MapError);
+  EXPECT_THROW(loadMap(kTmap2, MapFormat::kLegacyTmap), MapError);
+}
+
+TEST(MalformedMaps, MissingEdgeTarget) {
+  std::string e = errorOf(
+      "nodes:\n- node: {name: A, pose: {position: {x: 0, y: 0}}, edges: [{edge_id: A_B, node: B, action: x}]}\n");
+  EXPECT_NE(e.find("bad.tmap2"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown node 'B'"), std::string::npos) << e;
+  EXPECT_NE(e.find("node 'A'"), std::string::npos) << e;
+}
+
+TEST(MalformedMaps, DuplicateNodeName) {
+  std::string e = errorOf(
+      "nodes:\n- node: {name: A, pose: {position: {x: 0, y: 0}}}\n- node: {name: A, pose: {position: {x: 1, y: 0}}}\n");
+  EXPECT_NE(e.find("duplicate node name"), std::string::npos) << e;
+  EXPECT_NE(e.find("node 'A'"), std::string::npos) << e;
+}
+
+TEST(MalformedMaps, NonNumericPose) {
+  std::string e = errorOf("nodes:\n- node: {name: A, pose: {position: {x: abc, y: 0}}}\n");
+  EXPECT_NE(e.find("not a number: 'abc'"), std::string::npos) << e;
+  EXPECT_NE(e.find("field 'node.pose.position.x'"), std::string::npos) << e;
+  EXPECT_NE(errorOf("nodes:\n- node: {name: A, pose: {position: {x: .nan, y: 0}}}\n").find("not finite"),
+            std::string::npos);
+}
+
+TEST(MalformedMaps, MissingPositionField) {
+  std::string e = errorOf("nodes:\n- node: {name: A, pose: {position: {x: 1}}}\n");
+  EXPECT_NE(e.find("missing field"), std::string::npos) << e;
+  EXPECT_NE(e.find("node.pose.position.y"), std::string::npos) << e;
+}
+
+TEST(MalformedMaps, EmptyFile) {
+  EXPECT_NE(errorOf("").find("empty"), std::string::npos);
+  EXPECT_NE(errorOf("   \n# only a comment\n").find("empty"), std::string::npos);
+  EXPECT_NE(errorOf("nodes: []\n").find("no nodes"), std::string::npos);
+}
+
+TEST(MalformedMaps, WrongTopLevelType) {
+  EXPECT_NE(errorOf("42\n").find("not a topological map"), std::string::npos);
+  EXPECT_NE(errorOf("name: x\nedges: []\n").find("not a topological map"), std::string::npos);
+  EXPECT_NE(errorOf("nodes: {a: 1}\n").find("'nodes' must be a list"), std::string::npos);
+  EXPECT_NE(errorOf("- 1\n- 2\n").find("not a mapping"), std::string::npos);
+}
+
+TEST(MalformedMaps, SyntaxErrorAndUnreadableFile) {
+  EXPECT_NE(errorOf("nodes: [\n").find("YAML syntax error"), std::string::npos);
+  try {
+    loadMap("/nonexistent/dir/map.tmap2");
+    FAIL() << "no exception";
+  } catch (const MapError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/map.tmap2: cannot open"), std::string::npos);
+  }
+}
+
+TEST(Queries, NearestNodeMatchesLinearScan) {
+  TopologicalMap m = loadMap(kTmap2);
+  for (NodeIndex i = 0; i < m.numNodes(); ++i) EXPECT_EQ(m.nearestNode(m.position2d(i)), i);
+  // A grid of probe points over and beyond the bounding box.
+  for (double x = 0.0; x <= 45.0; x += 0.77)
+    for (double y = -50.0; y <= 15.0; y += 0.93) {
+      Eigen::Vector2d p(x, y);
+      NodeIndex got = m.nearestNode(p), want = bruteNearest(m, p);
+      EXPECT_DOUBLE_EQ((m.position2d(got) - p).norm(), (m.position2d(want) - p).norm());
+    }
+}
+
+TEST(Queries, NodesWithinMatchesLinearScan) {
+  TopologicalMap m = makePolytunnelMap(PolytunnelSpec{});
+  for (double r : {0.0, 1.0, 3.1, 7.5}) {
+    Eigen::Vector2d p(4.2, 7.7);
+    std::vector<NodeIndex> got = m.nodesWithin(p, r);
+    std::set<NodeIndex> got_set(got.begin(), got.end()), want;
+    for (NodeIndex i = 0; i < m.numNodes(); ++i)
+      if ((m.position2d(i) - p).norm() <= r) want.insert(i);
+    EXPECT_EQ(got_set, want) << "radius " << r;
+  }
+  EXPECT_TRUE(m.nodesWithin({0, 0}, -1.0).empty());
+}
+
+TEST(Queries, NeighboursEdgeLengthHopsAndPaths) {
+  // 2 lanes x 3 nodes: H0-r0_0-r0_1-r0_2-T0, H1-r1_0-r1_1-r1_2-T1, H0-H1, T0-T1.
+  PolytunnelSpec spec;
+  spec.lanes = 2;
+  spec.nodes_per_lane = 3;
+  spec.lane_spacing = 1.5;
+  spec.node_spacing = 3.0;
+  spec.headland_gap = 2.0;
+  TopologicalMap m = makePolytunnelMap(spec);
+  auto id = [&](const char* n) { return *m.index(n); };
+  EXPECT_EQ(m.numNodes(), 10u);
+  EXPECT_EQ(m.numUndirectedEdges(), 10u);
+  EXPECT_EQ(m.numDirectedEdges(), 20u);
+  EXPECT_EQ(m.neighbours(id("r0_1")), (std::vector<NodeIndex>{std::min(id("r0_0"), id("r0_2")),
+                                                             std::max(id("r0_0"), id("r0_2"))}));
+  EXPECT_DOUBLE_EQ(*m.edgeLength(id("r0_0"), id("r0_1")), 3.0);
+  EXPECT_DOUBLE_EQ(*m.edgeLength(id("H0"), id("r0_0")), 2.0);
+  EXPECT_FALSE(m.edgeLength(id("r0_0"), id("r1_0")).has_value());  // adjacent lanes are not connected sideways
+  EXPECT_EQ(m.hopDistance(id("r0_1"), id("r0_1")), 0);
+  EXPECT_EQ(m.hopDistance(id("r0_0"), id("r1_0")), 3);  // r0_0-H0-H1-r1_0
+  EXPECT_EQ(m.hopDistance(id("r1_0"), id("r0_0")), 3);  // symmetric, from the cache of another row
+  EXPECT_EQ(m.hopDistance(id("r0_1"), id("r1_1")), 5);  // r0_1-r0_0-H0-H1-r1_0-r1_1
+  // Path length: r0_0 -> H0 (2) -> H1 (1.5) -> r1_0 (2) = 5.5 m.
+  EXPECT_DOUBLE_EQ(m.pathLength(id("r0_0"), id("r1_0")), 5.5);
+  EXPECT_EQ(m.shortestPath(id("r0_0"), id("r1_0")),
+            (std::vector<NodeIndex>{id("r0_0"), id("H0"), id("H1"), id("r1_0")}));
+  EXPECT_DOUBLE_EQ(m.pathLength(id("T1"), id("T1")), 0.0);
+  EXPECT_DOUBLE_EQ(m.distance(id("r0_0"), id("r1_0")), 1.5);
+}
+
+TEST(Queries, UnreachableNodes) {
+  std::vector<Node> nodes(3);
+  nodes[0].name = "a";
+  nodes[1].name = "b";
+  nodes[1].position.x() = 1.0;
+  nodes[2].name = "island";
+  nodes[2].position.x() = 9.0;
+  TopologicalMap m = TopologicalMap::build("t", nodes, {{"a_b", "a", "b", ""}});
+  EXPECT_EQ(m.numComponents(), 2u);
+  EXPECT_EQ(m.hopDistance(0, 2), -1);
+  EXPECT_TRUE(std::isinf(m.pathLength(0, 2)));
+  EXPECT_TRUE(m.shortestPath(0, 2).empty());
+  // Duplicate directed edges are kept once; the reverse counts as another directed edge.
+  TopologicalMap d = TopologicalMap::build("t", nodes, {{"1", "a", "b", ""}, {"2", "a", "b", ""}, {"3", "b", "a", ""}});
+  EXPECT_EQ(d.numDirectedEdges(), 2u);
+  EXPECT_EQ(d.numUndirectedEdges(), 1u);
+}
+
+TEST(Lanes, RowTraversalRuleOnRiseholme) {
+  TopologicalMap m = loadMap(kTmap2);
+  // 12 rows of 10 nodes joined by row_traversal edges; 18 headland / dock nodes outside every lane.
+  ASSERT_EQ(m.numLanes(), 12u);
+  std::size_t in_lane = 0;
+  for (std::size_t l = 0; l < m.numLanes(); ++l) {
+    EXPECT_EQ(m.laneNodes(static_cast<LaneIndex>(l)).size(), 10u);
+    in_lane += m.laneNodes(static_cast<LaneIndex>(l)).size();
+  }
+  EXPECT_EQ(in_lane, 120u);
+  EXPECT_EQ(m.lane(*m.index("WayPoint1")), m.lane(*m.index("WayPoint9")));
+  EXPECT_NE(m.lane(*m.index("WayPoint1")), m.lane(*m.index("WayPoint10")));
+  EXPECT_EQ(m.lane(*m.index("dock_0")), kNoLane);
+  EXPECT_EQ(m.laneNameOf(*m.index("dock_0")), "");
+}
+
+TEST(Lanes, TagRuleWinsAndChainRuleFallsBack) {
+  TopologicalMap tagged = makePolytunnelMap(PolytunnelSpec{});
+  EXPECT_EQ(tagged.numLanes(), 12u);
+  EXPECT_EQ(tagged.laneNameOf(*tagged.index("r3_4")), "row_3");
+  EXPECT_EQ(tagged.lane(*tagged.index("H3")), kNoLane);
+
+  // Chain rule: a 4-node chain a-b-c-d hanging off a junction j with two short stubs.
+  std::vector<Node> nodes;
+  for (const char* n : {"j", "a", "b", "c", "d", "s1", "s2"}) {
+    Node node;
+    node.name = n;
+    node.position.x() = static_cast<double>(nodes.size());
+    nodes.push_back(node);
+  }
+  std::vector<EdgeSpec> edges{{"", "j", "a", "move_base"}, {"", "a", "b", "move_base"}, {"", "b", "c", "move_base"},
+                              {"", "c", "d", "move_base"}, {"", "j", "s1", "move_base"}, {"", "j", "s2", "move_base"}};
+  TopologicalMap chain = TopologicalMap::build("chain", nodes, edges);
+  ASSERT_EQ(chain.numLanes(), 1u);  // s1, s2 are single-node chains (< kMinChainLaneNodes)
+  EXPECT_EQ(chain.laneNodes(0).size(), 4u);
+  EXPECT_EQ(chain.lane(*chain.index("j")), kNoLane);
+  EXPECT_EQ(chain.lane(*chain.index("s1")), kNoLane);
+}
+
+TEST(Lanes, LegacyMapGetsChainLanes) {
+  TopologicalMap m = loadMap(kLegacy);
+  EXPECT_GE(m.numLanes(), 4u);
+  for (std::size_t l = 0; l < m.numLanes(); ++l) {
+    const auto& members = m.laneNodes(static_cast<LaneIndex>(l));
+    EXPECT_GE(members.size(), kMinChainLaneNodes);
+    for (NodeIndex u : members) EXPECT_LE(m.neighbours(u).size(), 2u);
+  }
+}
+
+TEST(SyntheticMaps, TenThousandNodes) {
+  TopologicalMap m = makePolytunnelMap(polytunnelSpecWithNodes(10000));
+  EXPECT_GE(m.numNodes(), 9000u);
+  EXPECT_LE(m.numNodes(), 11000u);
+  EXPECT_EQ(m.numComponents(), 1u);
+  EXPECT_EQ(m.numLanes(), polytunnelSpecWithNodes(10000).lanes);
+  // Spot-check the k-d tree on the big map.
+  for (double x = -2.0; x < 160.0; x += 13.7) {
+    Eigen::Vector2d p(x, x * 0.6);
+    EXPECT_DOUBLE_EQ((m.position2d(m.nearestNode(p)) - p).norm(), (m.position2d(bruteNearest(m, p)) - p).norm());
+  }
+  // Hop distances across the block: from the first lane's first node to the last lane's first node.
+  PolytunnelSpec s = polytunnelSpecWithNodes(10000);
+  NodeIndex a = *m.index("r0_0"), b = *m.index("r" + std::to_string(s.lanes - 1) + "_0");
+  EXPECT_EQ(m.hopDistance(a, b), static_cast<int>(s.lanes - 1) + 2);
+}
+
+TEST(MapCopy, CopiesAreIndependentAndQueryable) {
+  TopologicalMap m = loadMap(kTmap2);
+  TopologicalMap c = m;
+  EXPECT_EQ(c.numNodes(), m.numNodes());
+  EXPECT_EQ(c.nearestNode(m.position2d(5)), 5u);
+  EXPECT_EQ(c.hopDistance(0, 17), m.hopDistance(0, 17));
+}
