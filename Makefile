@@ -3,7 +3,7 @@ SHELL := /bin/bash
 MAKEFLAGS += --no-print-directory
 # Debian's python3 must come first: catkin and the ROS tools need its modules (pyenv's python3 lacks them).
 export PATH := /usr/bin:/bin:$(PATH)
-export ROS_LANG_DISABLE := genlisp:geneus:gennodejs
+export ROS_LANG_DISABLE := genlisp
 export ROS_HOSTNAME ?= localhost
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)

@@ -50,3 +50,41 @@ TEST(MapConversions, MarkersCoverNodesEdgesLabels) {
   EXPECT_TRUE(c0.r != c1.r || c0.g != c1.g || c0.b != c1.b);
   EXPECT_FLOAT_EQ(none.r, none.g);
 }
+
+#include "picker_localisation/ros/observation_conversions.h"
+
+TEST(ObservationConversions, RoundTripAndUnknownNodes) {
+  topology::TopologicalMap map = topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  core::Observation obs;
+  obs.stamp = 12.5;
+  obs.sensor = "gnss";
+  obs.picker_id = "picker_1";
+  obs.identifying = true;
+  obs.nodes = {3, 7};
+  obs.likelihood = {0.25, 1.0};
+  obs.velocity = Eigen::Vector2d(0.5, -0.1);
+  obs.position = Eigen::Vector2d(14.0, -20.0);
+  obs.position_covariance << 2.0, 0.1, 0.1, 3.0;
+  picker_localisation::Observation msg = ros_adapter::toMsg(obs, map);
+  EXPECT_EQ(msg.nodes[0], map.node(3).name);
+  EXPECT_DOUBLE_EQ(msg.header.stamp.toSec(), 12.5);
+  msg.nodes.push_back("NoSuchNode");
+  msg.likelihood.push_back(0.5);
+  std::size_t unknown = 0;
+  core::Observation back = ros_adapter::fromMsg(msg, map, &unknown);
+  EXPECT_EQ(unknown, 1u);
+  EXPECT_EQ(back.nodes, obs.nodes);
+  EXPECT_EQ(back.likelihood, obs.likelihood);
+  EXPECT_EQ(back.sensor, "gnss");
+  EXPECT_TRUE(back.identifying);
+  ASSERT_TRUE(back.velocity.has_value());
+  EXPECT_DOUBLE_EQ(back.velocity->x(), 0.5);
+  ASSERT_TRUE(back.position.has_value());
+  EXPECT_DOUBLE_EQ(back.position_covariance(1, 1), 3.0);
+  EXPECT_DOUBLE_EQ(back.position_covariance(0, 1), 0.1);
+  EXPECT_EQ(core::validateObservation(back, map), "");
+  // Lists of different lengths are caught by validation.
+  msg.likelihood.pop_back();
+  msg.likelihood.pop_back();
+  EXPECT_NE(core::validateObservation(ros_adapter::fromMsg(msg, map), map), "");
+}

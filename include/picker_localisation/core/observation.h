@@ -1,0 +1,52 @@
+// A sensor observation of a picker as the filters consume it: a sparse likelihood over map nodes
+// (Navigate-and-Seek Sec. IV: "each observation from sensor s is passed to the filter in the form of a
+// likelihood distribution L(N) ... paired with a variable id_s"). ROS-free.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/topology/topological_map.h"
+
+namespace picker_localisation {
+namespace core {
+
+struct Observation {
+  double stamp = 0.0;            // s, the measurement's own time stamp (never the wall clock)
+  std::string sensor;            // gnss | lidar | rfid | uwb | camera | ... (selects per-sensor gammas)
+  std::string robot_id;          // robot whose sensor produced it; empty for picker-worn devices
+  std::string picker_id;         // identified picker; empty when !identifying
+  bool identifying = false;
+  std::vector<topology::NodeIndex> nodes;  // support of the likelihood (unique indices)
+  std::vector<double> likelihood;          // >= 0, one per entry of nodes; need not sum to 1
+  std::optional<Eigen::Vector2d> velocity;  // m/s, map frame
+  std::optional<Eigen::Vector2d> position;  // metric position the likelihood came from, map frame, m
+  Eigen::Matrix2d position_covariance = Eigen::Matrix2d::Zero();  // m^2
+
+  bool empty() const { return nodes.empty(); }
+  double totalLikelihood() const;
+};
+
+// Options of a Gaussian node likelihood.
+struct GaussianLikelihoodOptions {
+  double cutoff_sigmas = 3.0;     // nodes farther than this many (largest) standard deviations are left out
+  double min_sigma = 0.0;         // floor on each standard deviation, m
+  std::size_t max_nodes = 0;      // keep at most this many most likely nodes (0: no limit)
+};
+
+// L(n) = exp(-0.5 d^T C^-1 d), d = node position - mean, over the nodes within the cut-off (k-d tree range
+// query: the cost does not grow with the map size). When no node lies within the cut-off the nearest node gets
+// the likelihood instead, so an observation is never empty. The covariance is regularised to be positive
+// definite with the sigma floor.
+void setGaussianLikelihood(Observation& obs, const topology::TopologicalMap& map, const Eigen::Vector2d& mean,
+                           const Eigen::Matrix2d& covariance, const GaussianLikelihoodOptions& options = {});
+
+// Checks an observation against a map: indices in range, values finite and >= 0, sizes equal, something
+// positive. Returns an empty string when valid, else the reason.
+std::string validateObservation(const Observation& obs, const topology::TopologicalMap& map);
+
+}  // namespace core
+}  // namespace picker_localisation

@@ -1,0 +1,45 @@
+// The pickers a deployment tracks, from config/pickers.yaml. ROS-free.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace picker_localisation {
+namespace core {
+
+struct PickerConfig {
+  std::string id;                      // unique; names the tracker, topics and frames (/pickers/<id>/...)
+  std::string gnss_topic;              // sensor_msgs/NavSatFix topic of the picker's phone / IoT unit ("" none)
+  std::vector<std::string> rfid_tags;  // RFID tag ids worn by the picker
+  std::string uwb_tag;                 // UWB tag id worn by the picker ("" none)
+};
+
+// Format:
+//   pickers:
+//     - id: picker_1
+//       gnss_topic: /pickers/picker_1/fix
+//       rfid_tags: [tag_0001]
+//       uwb_tag: uwb_0001
+// Throws std::runtime_error with one line naming the file, the entry and the field on a bad file
+// (missing or duplicate id, a tag claimed by two pickers, wrong types).
+class PickerRegistry {
+ public:
+  static PickerRegistry load(const std::string& path);
+  static PickerRegistry parse(const std::string& yaml_text, const std::string& source = "<memory>");
+  explicit PickerRegistry(std::vector<PickerConfig> pickers = {}, const std::string& source = "<memory>");
+
+  const std::vector<PickerConfig>& pickers() const { return pickers_; }
+  std::size_t size() const { return pickers_.size(); }
+  const PickerConfig* find(const std::string& id) const;
+  // Picker wearing the RFID / UWB tag; nullopt for an unknown tag.
+  std::optional<std::string> pickerForRfidTag(const std::string& tag) const;
+  std::optional<std::string> pickerForUwbTag(const std::string& tag) const;
+  std::vector<std::string> ids() const;
+
+ private:
+  std::vector<PickerConfig> pickers_;
+};
+
+}  // namespace core
+}  // namespace picker_localisation

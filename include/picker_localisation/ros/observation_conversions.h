@@ -1,0 +1,20 @@
+// Observation message <-> core Observation (nodes by name in messages, by index in the core).
+#pragma once
+
+#include <picker_localisation/Observation.h>
+
+#include "picker_localisation/core/observation.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+picker_localisation::Observation toMsg(const core::Observation& obs, const topology::TopologicalMap& map,
+                                       const std::string& frame_id = "map");
+
+// Converts a message. Node names not in the map are skipped and counted in *unknown_nodes (when given);
+// sizes that differ, non-finite values and the like are left for validateObservation() to report.
+core::Observation fromMsg(const picker_localisation::Observation& msg, const topology::TopologicalMap& map,
+                    std::size_t* unknown_nodes = nullptr);
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

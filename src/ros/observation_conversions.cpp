@@ -1,0 +1,66 @@
+#include "picker_localisation/ros/observation_conversions.h"
+
+#include <cmath>
+#include <limits>
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+picker_localisation::Observation toMsg(const core::Observation& obs, const topology::TopologicalMap& map,
+                                       const std::string& frame_id) {
+  picker_localisation::Observation msg;
+  msg.header.stamp = ros::Time(std::max(0.0, obs.stamp));
+  msg.header.frame_id = frame_id;
+  msg.sensor = obs.sensor;
+  msg.robot_id = obs.robot_id;
+  msg.picker_id = obs.picker_id;
+  msg.identifying = obs.identifying;
+  msg.nodes.reserve(obs.nodes.size());
+  for (topology::NodeIndex n : obs.nodes) msg.nodes.push_back(map.node(n).name);
+  msg.likelihood = obs.likelihood;
+  msg.has_velocity = obs.velocity.has_value();
+  if (obs.velocity) {
+    msg.velocity.x = obs.velocity->x();
+    msg.velocity.y = obs.velocity->y();
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  msg.position.x = obs.position ? obs.position->x() : nan;
+  msg.position.y = obs.position ? obs.position->y() : nan;
+  msg.position.z = obs.position ? 0.0 : nan;
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 2; ++c) msg.position_covariance[static_cast<std::size_t>(r * 3 + c)] = obs.position_covariance(r, c);
+  return msg;
+}
+
+core::Observation fromMsg(const picker_localisation::Observation& msg, const topology::TopologicalMap& map,
+                    std::size_t* unknown_nodes) {
+  core::Observation obs;
+  obs.stamp = msg.header.stamp.toSec();
+  obs.sensor = msg.sensor;
+  obs.robot_id = msg.robot_id;
+  obs.picker_id = msg.picker_id;
+  obs.identifying = msg.identifying;
+  std::size_t unknown = 0;
+  const std::size_t n = std::min(msg.nodes.size(), msg.likelihood.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    auto idx = map.index(msg.nodes[i]);
+    if (!idx) {
+      ++unknown;
+      continue;
+    }
+    obs.nodes.push_back(*idx);
+    obs.likelihood.push_back(msg.likelihood[i]);
+  }
+  if (msg.nodes.size() != msg.likelihood.size()) obs.likelihood.push_back(std::numeric_limits<double>::quiet_NaN());
+  if (unknown_nodes) *unknown_nodes = unknown;
+  if (msg.has_velocity) obs.velocity = Eigen::Vector2d(msg.velocity.x, msg.velocity.y);
+  if (std::isfinite(msg.position.x) && std::isfinite(msg.position.y)) {
+    obs.position = Eigen::Vector2d(msg.position.x, msg.position.y);
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 2; ++c) obs.position_covariance(r, c) = msg.position_covariance[static_cast<std::size_t>(r * 3 + c)];
+  }
+  return obs;
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,100 @@
+// Shared contracts: Gaussian node likelihoods, observation validation, the picker registry.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/topology/synthetic_map.h"
+
+using namespace picker_localisation;
+using namespace picker_localisation::core;
+using topology::NodeIndex;
+
+TEST(GaussianLikelihood, ValuesAndSupport) {
+  topology::PolytunnelSpec spec;  // lane k at x = 1.5 k, nodes every 3 m along y
+  topology::TopologicalMap map = topology::makePolytunnelMap(spec);
+  Observation obs;
+  const Eigen::Vector2d mean(3.0, 6.0);  // exactly on r2_2
+  setGaussianLikelihood(obs, map, mean, Eigen::Matrix2d::Identity() * 1.0);
+  ASSERT_EQ(obs.nodes.size(), obs.likelihood.size());
+  for (std::size_t i = 0; i < obs.nodes.size(); ++i) {
+    const double d = (map.position2d(obs.nodes[i]) - mean).norm();
+    EXPECT_LE(d, 3.0 + 1e-9);                                   // 3 sigma cut-off
+    EXPECT_NEAR(obs.likelihood[i], std::exp(-0.5 * d * d), 1e-12);  // hand formula, unit covariance
+  }
+  NodeIndex on = *map.index("r2_2");
+  auto it = std::find(obs.nodes.begin(), obs.nodes.end(), on);
+  ASSERT_NE(it, obs.nodes.end());
+  EXPECT_DOUBLE_EQ(obs.likelihood[static_cast<std::size_t>(it - obs.nodes.begin())], 1.0);
+  EXPECT_EQ(validateObservation(obs, map), "");
+}
+
+TEST(GaussianLikelihood, FarAwayFallsBackToNearestNodeAndSigmaFloor) {
+  topology::TopologicalMap map = topology::makePolytunnelMap(topology::PolytunnelSpec{});
+  Observation obs;
+  setGaussianLikelihood(obs, map, Eigen::Vector2d(-500.0, 0.0), Eigen::Matrix2d::Identity() * 0.01);
+  ASSERT_EQ(obs.nodes.size(), 1u);
+  EXPECT_EQ(obs.nodes[0], map.nearestNode(Eigen::Vector2d(-500.0, 0.0)));
+  EXPECT_GT(obs.likelihood[0], 0.0);
+  // A zero covariance with a 2 m floor still spreads over neighbours.
+  GaussianLikelihoodOptions o;
+  o.min_sigma = 2.0;
+  setGaussianLikelihood(obs, map, Eigen::Vector2d(3.0, 6.0), Eigen::Matrix2d::Zero(), o);
+  EXPECT_GT(obs.nodes.size(), 3u);
+  o.max_nodes = 2;
+  setGaussianLikelihood(obs, map, Eigen::Vector2d(3.0, 6.0), Eigen::Matrix2d::Zero(), o);
+  EXPECT_EQ(obs.nodes.size(), 2u);
+}
+
+TEST(ObservationValidation, RejectsBadInput) {
+  topology::TopologicalMap map = topology::makePolytunnelMap(topology::PolytunnelSpec{});
+  Observation obs;
+  obs.nodes = {0, 1};
+  obs.likelihood = {0.5, 0.5};
+  EXPECT_EQ(validateObservation(obs, map), "");
+  Observation bad = obs;
+  bad.likelihood[1] = std::nan("");
+  EXPECT_NE(validateObservation(bad, map), "");
+  bad = obs;
+  bad.nodes[1] = static_cast<NodeIndex>(map.numNodes());
+  EXPECT_NE(validateObservation(bad, map), "");
+  bad = obs;
+  bad.likelihood = {0.0, 0.0};
+  EXPECT_NE(validateObservation(bad, map), "");
+  bad = obs;
+  bad.nodes = {1, 1};
+  EXPECT_NE(validateObservation(bad, map), "");
+  bad = obs;
+  bad.identifying = true;
+  EXPECT_NE(validateObservation(bad, map), "");
+  bad = Observation();
+  EXPECT_EQ(validateObservation(bad, map), "empty likelihood");
+}
+
+TEST(PickerRegistry, ShippedConfigAndLookups) {
+  PickerRegistry r = PickerRegistry::load(std::string(PL_PACKAGE_DIR) + "/config/pickers.yaml");
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r.ids(), (std::vector<std::string>{"picker_1", "picker_2", "picker_3"}));
+  EXPECT_EQ(r.pickerForRfidTag("rfid_0002").value(), "picker_2");
+  EXPECT_EQ(r.pickerForUwbTag("uwb_0003").value(), "picker_3");
+  EXPECT_FALSE(r.pickerForRfidTag("nope").has_value());
+  EXPECT_FALSE(r.pickerForUwbTag("").has_value());
+  EXPECT_EQ(r.find("picker_1")->gnss_topic, "/pickers/picker_1/fix");
+  EXPECT_EQ(r.find("ghost"), nullptr);
+}
+
+TEST(PickerRegistry, BadFiles) {
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{gnss_topic: x}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a}, {id: a}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, rfid_tags: [t]}, {id: b, rfid_tags: [t]}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, uwb_tag: u}, {id: b, uwb_tag: u}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("[1, 2]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, rfid_tags: {x: 1}}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::load("/nonexistent.yaml"), std::runtime_error);
+  try {
+    PickerRegistry::parse("pickers: [{id: a}, {id: a}]", "p.yaml");
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("p.yaml: duplicate picker id 'a'"), std::string::npos) << e.what();
+  }
+}
