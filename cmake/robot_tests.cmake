@@ -1,0 +1,1 @@
+pl_add_gtest(test_robot_description test/test_robot_description.cpp LIBS picker_localisation_robot)
