@@ -1,0 +1,54 @@
+// Cluster tracking across scans: seed 003 Algorithm 1 (hit/miss hysteresis: a track is confirmed after T_a
+// updates and removed after T_o scans without one) with the Munkres assignment of Sec. 6.3.3 in place of
+// Algorithm 1's first-match loop, and a distance gate d_min. Positions are in one fixed frame (the node
+// transforms to map/odom first, which is Algorithm 4's RotoTranslate step). ROS-free, deterministic.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace picker_localisation {
+namespace sensors {
+
+struct ClusterTrackerOptions {
+  double gate_distance = 0.5;   // d_min: a detection farther than this from a track is never assigned to it, m
+  int hits_to_confirm = 3;      // T_a: consecutive updates before a tentative track is confirmed
+  int misses_to_delete = 5;     // T_o: scans without an update before a track is removed
+  int tentative_misses = 1;     // a tentative track missing this many scans is dropped at once
+  double velocity_smoothing = 0.5;  // weight of the newest finite-difference velocity (0..1]
+};
+
+struct ClusterTrack {
+  int id = -1;                       // stable id, unique for the tracker's life
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // m/s, smoothed finite difference
+  int hits = 0;                      // updates so far
+  int misses = 0;                    // consecutive scans without an update
+  bool confirmed = false;            // track_j of Algorithm 1
+  bool updated = false;              // updated_j in the last step
+  int detection = -1;                // index of the detection assigned in the last step, -1 if none
+  double last_update = 0.0;          // stamp of the last update, s
+};
+
+class ClusterTracker {
+ public:
+  explicit ClusterTracker(ClusterTrackerOptions options = {});
+
+  // One step with the detections of one scan at `stamp`. Stamps going backwards reset nothing but are not
+  // used for velocity. Returns every live track (confirmed or not) after the step.
+  const std::vector<ClusterTrack>& update(double stamp, const std::vector<Eigen::Vector2d>& detections);
+  const std::vector<ClusterTrack>& tracks() const { return tracks_; }
+  std::vector<ClusterTrack> confirmedTracks() const;
+  void reset();
+
+ private:
+  ClusterTrackerOptions options_;
+  std::vector<ClusterTrack> tracks_;
+  int next_id_ = 0;
+  double last_stamp_ = 0.0;
+  bool has_stamp_ = false;
+};
+
+}  // namespace sensors
+}  // namespace picker_localisation

@@ -1,0 +1,61 @@
+// Scan -> clusters (Algorithm 3) -> features -> leg classifier -> legs paired into people. ROS-free; the
+// offline experiment runner calls it in-process on simulated scans.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+#include "picker_localisation/sensors_vision/laser_scan.h"
+#include "picker_localisation/sensors_vision/leg_classifier.h"
+
+namespace picker_localisation {
+namespace sensors {
+
+struct Leg {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // cluster centroid, m, scan frame
+  double confidence = 0.0;                              // classifier leg probability
+  std::size_t cluster_index = 0;                        // index into LegDetection::clusters
+};
+
+struct Person {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // m, frame of the legs
+  double confidence = 0.0;                              // [0, 1]
+  int leg_a = -1, leg_b = -1;                           // indices into the legs; leg_b == -1 for a single leg
+};
+
+struct LegDetection {
+  double stamp = 0.0;
+  std::vector<ScanCluster> clusters;  // every segmented cluster
+  std::vector<Leg> legs;              // clusters classified as legs
+  std::vector<Person> people;         // legs paired into people
+};
+
+struct LegDetectorOptions {
+  SegmentationOptions segmentation;
+  double leg_threshold = 0.5;          // minimum leg probability for a cluster to be a leg
+  double max_leg_range = 8.0;          // clusters farther from the sensor are ignored, m
+  double max_leg_width = 0.5;          // clusters wider than this are never legs, m
+  double max_pair_distance = 0.7;      // two legs closer than this may be one person, m
+  bool single_leg_people = true;       // an unpaired leg is a person (other leg occluded) ...
+  double single_leg_factor = 0.5;      // ... with its confidence scaled by this factor
+};
+
+// Pairs legs into people: greedy by increasing distance, each leg used once, pairs closer than
+// max_pair_distance; a pair's position is the midpoint and its confidence the mean leg probability.
+std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOptions& options);
+
+class LegDetector {
+ public:
+  LegDetector(std::shared_ptr<const LegClassifier> classifier, LegDetectorOptions options = {});
+  LegDetection detect(const LaserScanData& scan) const;
+  const LegDetectorOptions& options() const { return options_; }
+
+ private:
+  std::shared_ptr<const LegClassifier> classifier_;
+  LegDetectorOptions options_;
+};
+
+}  // namespace sensors
+}  // namespace picker_localisation
