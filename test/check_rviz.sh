@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# rviz loads rviz/picker_localisation.rviz under Xvfb and renders: the process stays up, the log reports no
+# config/plugin errors, and a screenshot of the screen is not blank. Usage: check_rviz.sh OUT.png [LAUNCH]
+set -u
+out="${1:-/tmp/rviz.png}"
+launch="${2:-$(rospack find picker_localisation)/test/rviz_check.launch}"
+settle="${RVIZ_SETTLE:-12}"
+export PATH=/usr/bin:$PATH
+port=$((20000 + RANDOM % 20000))
+export ROS_MASTER_URI="http://localhost:$port" ROS_HOSTNAME=localhost
+log="$(mktemp)"; alive="$(mktemp)"
+xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+  roslaunch -p $port '$launch' > '$log' 2>&1 &
+  sleep $settle
+  import -window root '$out'
+  pgrep -f 'rviz -d' >/dev/null && echo RVIZ_ALIVE > '$alive'
+  rosnode kill -a >/dev/null 2>&1; sleep 1; kill %1 2>/dev/null; wait
+" >/dev/null 2>&1
+fail=0
+grep -q RVIZ_ALIVE "$alive" || { echo "FAIL: rviz is not running after ${settle} s"; fail=1; }
+if grep -E "PluginlibFactory: The plugin for class|Failed to load|ERROR" "$log" | grep -v -E "media_export|XDG_RUNTIME_DIR"; then
+  echo "FAIL: errors in the rviz log above"; fail=1
+fi
+[ -s "$out" ] || { echo "FAIL: no screenshot"; exit 1; }
+std="$(convert "$out" -colorspace Gray -format '%[fx:standard_deviation]' info:)"
+colours="$(convert "$out" -format '%k' info:)"
+echo "screenshot $out: grey std $std, $colours colours"
+awk -v s="$std" 'BEGIN{exit !(s > 0.05)}' || { echo "FAIL: screenshot is nearly uniform"; fail=1; }
+[ "$colours" -gt 50 ] || { echo "FAIL: too few colours"; fail=1; }
+[ $fail -eq 0 ] || { echo "--- roslaunch log ---"; tail -40 "$log"; }
+rm -f "$log" "$alive"
+exit $fail
