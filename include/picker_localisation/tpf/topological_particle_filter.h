@@ -1,0 +1,181 @@
+// The Topological Particle Filter of Navigate-and-Seek (Sec. IV, Algorithm 1, Eqs. 1-12): a belief over the
+// nodes of a topological map, one filter per picker. ROS-free; time comes from observation stamps only and
+// every random draw from the filter's own std::mt19937_64.
+//
+// Usage:
+//   auto map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(path));
+//   TopologicalParticleFilter tpf(map, TpfParams::fromYamlFile("config/tpf.yaml"), /*seed=*/1);
+//   UpdateResult r = tpf.update(observation);   // Algorithm 1 (initialises on the first accepted one)
+//   tpf.predictTo(stamp);                        // periodic prediction when nothing arrives
+//   const Belief& b = tpf.belief();              // sparse node masses, MAP node (Eq. 10), entropy, JSD ...
+//
+// Update cost: O(particles + support of the observation + degree); nothing per update is O(|N|). The filter
+// owns two |N|-sized scratch arrays allocated once at construction that are kept all-zero between updates
+// and only touched at the nodes that hold particles or likelihood.
+//
+// Interpretation choices where the paper is vague (details at the code):
+//  * Eqs. 2/3: Eq. 3 read literally (softmax of exp(lambda*tau)) gives the LARGEST probability to nodes against
+//    the velocity (lambda = 0), contradicting the text ("null probability to those in the opposite
+//    direction"). We use the decomposition of Eq. 2 itself: P(jump to k) = b_k (1 - exp(lambda_k tau)) / sum b,
+//    so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen. Without any
+//    positive projection (sum b = 0) a particle stays.
+//  * tau in Eq. 2 is the dwell time at the prediction instant (tau_t + dt); at most one jump per prediction.
+//  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector along
+//    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the probability of the transition taken; a
+//    particle that stays keeps its velocity (the literal d = 0 case would decay it towards 0 while waiting).
+//  * Eq. 8: L enters normalised to its maximum (likelihood scale is arbitrary, see core::Observation), the
+//    Gaussian g is unnormalised (peak 1) with sigma = max(|v^s|/2, min_velocity_sigma); w_v = 0 when the
+//    observation carries no velocity.
+//  * All weights zero (support disjoint from the particles, no velocity): no weighting or resampling, the
+//    predicted particles are kept, status kAccepted with reason "no overlap".
+//  * JSD (base-2 logs, so in [0, 1]) and entropy H (nats) over the support present. p_rj follows Algorithm 1:
+//    set to unconnected_jump_probability at start and on re-initialisation, to 0 once H < epsilon_H.
+//  * Late observations: stamp < last update stamp but within reorder_window are fused at the current time
+//    with no prediction (status kReordered); older ones are dropped and counted (kDroppedTooOld). The filter
+//    never predicts backwards.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/topology/topological_map.h"
+#include "picker_localisation/tpf/tpf_params.h"
+
+namespace picker_localisation {
+namespace tpf {
+
+// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter).
+struct Particle {
+  topology::NodeIndex node = topology::kInvalidNode;  // q
+  float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
+  double dwell = 0.0;                                 // tau, s
+};
+
+enum class UpdateStatus {
+  kAccepted,         // predicted to the stamp, weighted, resampled
+  kReordered,        // late (within reorder_window): fused at the filter's current time without prediction
+  kDroppedTooOld,    // older than the last update by more than reorder_window: ignored, counted
+  kIgnoredSensor,    // sensor not in accepted_sensors (e.g. LiDAR in Khan mode): ignored, counted
+  kRejectedInvalid,  // malformed (NaN, node out of range, sizes differ, nothing positive ...): ignored
+};
+const char* toString(UpdateStatus s);
+
+struct UpdateResult {
+  UpdateStatus status = UpdateStatus::kAccepted;
+  std::string reason;          // empty on success; one line otherwise
+  bool initialised = false;    // this observation initialised the filter (Eq. 1, first observation)
+  bool reinitialised = false;  // the JSD monitor re-initialised the filter (Algorithm 1 l. 6-9)
+  bool ok() const { return status == UpdateStatus::kAccepted || status == UpdateStatus::kReordered; }
+};
+
+struct FilterCounters {
+  std::uint64_t accepted = 0, reordered = 0, dropped_too_old = 0, ignored_sensor = 0, rejected_invalid = 0;
+  std::uint64_t reinitialisations = 0, predictions = 0, no_overlap = 0;
+};
+
+// The belief after the last update or prediction.
+struct Belief {
+  bool initialised = false;
+  double stamp = 0.0;                       // s, stamp of the last update / prediction
+  std::vector<topology::NodeIndex> nodes;   // support (nodes holding particles), ascending index
+  std::vector<double> masses;               // normalised topological mass per node (Eq. 9), sums to 1
+  topology::NodeIndex map_node = topology::kInvalidNode;  // n* (Eq. 10); ties -> lowest index
+  double entropy = 0.0;                     // H of the particles' node distribution, nats (Alg. 1 l. 12)
+  double jsd = 0.0;                         // JSD of the last observation vs the predicted particles, [0, 1]
+  bool reinitialised = false;               // the last update re-initialised the particles
+  double unconnected_jump_probability = 0.0;  // current p_rj
+  std::size_t particle_count = 0;
+  std::uint64_t observations = 0;           // observations fused since construction / reset
+  double massOf(topology::NodeIndex n) const;  // 0 outside the support
+};
+
+class TopologicalParticleFilter {
+ public:
+  // Throws std::invalid_argument on a null/empty map or invalid params (TpfParams::validate()).
+  TopologicalParticleFilter(std::shared_ptr<const topology::TopologicalMap> map, TpfParams params,
+                            std::uint64_t seed);
+
+  // Algorithm 1 for one observation. Never throws on bad input: returns the status and reason instead and
+  // leaves the belief untouched.
+  UpdateResult update(const core::Observation& obs);
+  // Prediction only (Eqs. 2-7) to `stamp` (periodic prediction). No-op returning false before the first
+  // observation or when stamp is not after the last update.
+  bool predictTo(double stamp);
+  // Forget everything: the next observation initialises the filter again (Eq. 1).
+  void reset();
+
+  const Belief& belief() const { return belief_; }
+  const FilterCounters& counters() const { return counters_; }
+  const std::vector<Particle>& particles() const { return particles_; }
+  const TpfParams& params() const { return params_; }
+  const topology::TopologicalMap& map() const { return *map_; }
+  std::shared_ptr<const topology::TopologicalMap> mapPtr() const { return map_; }
+  bool initialised() const { return belief_.initialised; }
+  double lastStamp() const { return belief_.stamp; }
+
+  // --- what-if (planner): work on a copy, the live filter is untouched ------------------------------------
+  // A copy whose generator is re-seeded with `seed` (0: the copy keeps the live generator's state).
+  TopologicalParticleFilter copyWithSeed(std::uint64_t seed) const;
+  // Belief after predicting `seconds` (>= 0) beyond the last update.
+  Belief predictAhead(double seconds, std::uint64_t seed = 0) const;
+  // Belief after predicting `seconds` ahead and fusing `hypothetical` at that time (its stamp is ignored).
+  // An invalid hypothetical observation returns the predicted belief; `result` (optional) tells why.
+  Belief posteriorUnder(const core::Observation& hypothetical, double seconds = 0.0, std::uint64_t seed = 0,
+                        UpdateResult* result = nullptr) const;
+
+  // --- the equations, exposed for tests and the planner ---------------------------------------------------
+  // Eq. 6: lambda = 2 log(1/2) max(0, proj) / d (1/s, <= 0). proj = v . (p_k - p_q)/|p_k - p_q|.
+  static double lambda(double projected_speed, double distance);
+  // Un-normalised jump probability of one edge in Eq. 2: 1 - exp(lambda * tau).
+  static double edgeJumpProbability(double lambda, double dwell);
+  // Eq. 2 for particle state (node, velocity, dwell): probability of leaving the node.
+  double jumpProbability(topology::NodeIndex node, double vx, double vy, double dwell) const;
+  // Eq. 2-3 per neighbour: probability of jumping to each motion neighbour of `node` (same order as
+  // motionNeighbours(node)); sums to jumpProbability().
+  std::vector<double> transitionProbabilities(topology::NodeIndex node, double vx, double vy,
+                                              double dwell) const;
+  // Eq. 8 weight of a particle for a likelihood value L^ in [0, 1] (already normalised to its maximum).
+  double particleWeight(const Particle& p, double normalised_likelihood, const core::Observation& obs) const;
+  // JSD (base 2) between two sparse distributions given as (node, probability) lists (each summing to 1).
+  static double jensenShannonDistance(const std::vector<std::pair<topology::NodeIndex, double>>& p,
+                                      const std::vector<std::pair<topology::NodeIndex, double>>& q);
+  // Entropy (nats) of a distribution given by its probabilities.
+  static double entropy(const std::vector<double>& probabilities);
+
+ private:
+  struct MotionGraph;  // CSR adjacency with unit edge directions and lengths, shared by copies
+
+  UpdateResult reject(UpdateStatus status, std::string reason);
+  void initialise(const core::Observation& obs);
+  void predict(double dt);
+  double observationJsd(const core::Observation& obs, double max_likelihood);
+  bool weightAndResample(const core::Observation& obs, double max_likelihood);
+  void resample();
+  void addNoise();
+  void recordBelief(bool with_weights);
+  void fuse(const core::Observation& obs, double dt, UpdateResult& result);
+
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::shared_ptr<const MotionGraph> graph_;
+  TpfParams params_;
+  std::uint64_t seed_;
+  std::mt19937_64 rng_;
+
+  std::vector<Particle> particles_;
+  std::vector<Particle> resampled_;  // scratch, same size as particles_
+  std::vector<double> weights_;      // per particle, scratch
+  // |N|-sized scratch, all zero between calls (touched entries are cleared after use).
+  std::vector<double> node_scratch_a_, node_scratch_b_;
+  std::vector<topology::NodeIndex> touched_;
+
+  double unconnected_p_ = 0.0;  // p_rj
+  Belief belief_;
+  FilterCounters counters_;
+};
+
+}  // namespace tpf
+}  // namespace picker_localisation

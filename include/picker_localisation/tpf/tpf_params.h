@@ -1,0 +1,104 @@
+// Parameters of the Topological Particle Filter (Navigate-and-Seek Sec. IV, Table I) and the baselines /
+// ablations of Table II expressed as parameter presets (never code forks). ROS-free.
+//
+// Defaults are Table I; config/tpf.yaml documents every field with its meaning and unit.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace picker_localisation {
+namespace tpf {
+
+// Per-sensor weighting factors of Eq. 8.
+struct SensorGamma {
+  double node = 1.0;      // gamma^s_q: weight of the node likelihood term w_q
+  double velocity = 0.0;  // gamma^s_v: weight of the velocity agreement term w_v
+};
+
+// How particles move between nodes.
+enum class MotionModel {
+  kVelocity,     // Eqs. 2-7: lambda from the particle velocity projected on each edge (Eq. 6), velocity state
+                 // updated over the window V (Eq. 7); the full TPF.
+  kFixedLambda,  // Khan et al. [1] Eq. 2 / ConstantSpeed ablation: jump probability 1 - exp(-fixed_lambda * tau)
+                 // to a uniformly chosen neighbour; particle velocity neither used nor estimated, w_v = 0.
+};
+
+enum class ResamplingScheme {
+  kLowVariance,  // systematic / low-variance resampling (one uniform draw per resampling), default
+  kMultinomial,  // independent draws (Eq. 11 read literally)
+};
+
+struct TpfParams {
+  // --- particles -----------------------------------------------------------------------------------------
+  std::size_t num_particles = 1000;
+  ResamplingScheme resampling = ResamplingScheme::kLowVariance;
+
+  // --- Eq. 1, initialisation (Table I) ---------------------------------------------------------------------
+  double velocity_init_mean = 0.0;       // mu_init, m/s, per component
+  double velocity_init_variance = 5e-2;  // sigma^2_init, (m/s)^2, per component
+  double dwell_init_min = 0.0;           // tau^-_init, s
+  double dwell_init_max = 1.0;           // tau^+_init, s
+
+  // --- Eq. 12, resampling noise (Table I) ------------------------------------------------------------------
+  double velocity_noise_mean = 0.0;       // mu_noise, m/s
+  double velocity_noise_variance = 5e-4;  // sigma^2_noise, (m/s)^2
+  double dwell_noise_min = -0.1;          // tau^-_noise, s
+  double dwell_noise_max = 0.1;           // tau^+_noise, s
+
+  // --- Eqs. 2-7, prediction --------------------------------------------------------------------------------
+  MotionModel motion_model = MotionModel::kVelocity;
+  double fixed_lambda = 0.1;       // 1/s, Khan et al.'s constant rate (kFixedLambda only)
+  double velocity_window = 10.0;   // V of Eq. 7 (dimensionless number of steps; not in Table I)
+  double min_jump_dwell = 0.1;     // s, floor on the dwell time used for the observed speed of Eq. 7
+  bool directed_motion = false;    // true: particles follow file edge direction; false: undirected graph
+
+  // --- Eq. 8, weighting ------------------------------------------------------------------------------------
+  // Keyed by Observation::sensor. Table I: gnss (1, 1), lidar (0.25, 0), rfid (1, 0). Choices for sensors
+  // the paper does not use: uwb (1, 0) like RFID (identifying range), camera (0.25, 0) like LiDAR.
+  std::map<std::string, SensorGamma> sensor_gammas;
+  SensorGamma default_gamma{0.25, 0.0};  // for a sensor missing from sensor_gammas (anonymous, low trust)
+  // false (paper): w_q = gamma_q * L^(q). true: w_q = gamma_q * L^(q) + (1 - gamma_q), i.e. gamma_q is the
+  // confidence in the sensor and a low-confidence sensor only nudges the belief. L^ = L / max L.
+  bool gamma_as_confidence = false;
+  double min_velocity_sigma = 0.05;  // m/s, floor on sigma = |v^s| / 2 of the Gaussian of Eq. 8
+  // Sensors this filter fuses; empty = all. Observations of other sensors are ignored (counted).
+  std::vector<std::string> accepted_sensors;
+
+  // --- Algorithm 1, monitors ---------------------------------------------------------------------------------
+  bool jsd_monitor = true;          // re-initialise when JSD > jsd_threshold on an identifying observation
+  double jsd_threshold = 0.975;     // epsilon_JSD, [0, 1]
+  bool entropy_gate = true;         // set p_rj to 0 once the entropy drops below entropy_threshold
+  double entropy_threshold = 0.6;   // epsilon_H, nats
+  double unconnected_jump_probability = 1e-3;  // p_rj at start and after each re-initialisation (Alg. 1 l. 8)
+
+  // --- time ------------------------------------------------------------------------------------------------
+  double prediction_rate = 0.25;  // Hz, periodic prediction when no observation arrives (used by the node)
+  double reorder_window = 1.0;    // s, late observations within this window are fused at the current time
+
+  TpfParams();  // fills sensor_gammas with the Table I values
+
+  SensorGamma gammaFor(const std::string& sensor) const;
+  bool acceptsSensor(const std::string& sensor) const;
+  // Empty string when valid, else the first problem (one line).
+  std::string validate() const;
+
+  // Reads a YAML node with the keys of config/tpf.yaml (missing keys keep the defaults above; a `method`
+  // key applies presetForMethod first). Throws std::runtime_error naming the key on a bad value.
+  static TpfParams fromYaml(const YAML::Node& node);
+  static TpfParams fromYamlFile(const std::string& path);
+  // Table II method names: "tpf" (full filter, default), "khan_connected", "khan_unconnected", "no_monitor",
+  // "constant_speed". Throws std::invalid_argument for an unknown name.
+  static TpfParams presetForMethod(const std::string& method, const TpfParams& base = TpfParams());
+  static std::vector<std::string> methodNames();
+};
+
+const char* toString(MotionModel m);
+const char* toString(ResamplingScheme r);
+
+}  // namespace tpf
+}  // namespace picker_localisation

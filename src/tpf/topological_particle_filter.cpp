@@ -1,0 +1,541 @@
+#include "picker_localisation/tpf/topological_particle_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace picker_localisation {
+namespace tpf {
+
+using topology::NodeIndex;
+
+namespace {
+constexpr double kLogHalf = -0.69314718055994530942;  // log(1/2)
+constexpr double kMinEdgeLength = 1e-6;                // m; shorter edges have no direction
+
+// Uniform double in [0, 1) from 53 random bits.
+inline double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+}  // namespace
+
+// Compressed adjacency of the motion graph (successors or undirected neighbours) with the unit direction and
+// length of every edge, built once per filter and shared by its copies.
+struct TopologicalParticleFilter::MotionGraph {
+  std::vector<std::uint32_t> offsets;  // |N| + 1
+  std::vector<NodeIndex> targets;
+  std::vector<double> ux, uy, length;
+  std::size_t max_degree = 0;
+
+  MotionGraph(const topology::TopologicalMap& map, bool directed) {
+    const std::size_t n = map.numNodes();
+    offsets.resize(n + 1, 0);
+    for (NodeIndex i = 0; i < n; ++i) {
+      const auto& nb = map.motionNeighbours(i, directed);
+      offsets[i + 1] = offsets[i] + static_cast<std::uint32_t>(nb.size());
+      max_degree = std::max(max_degree, nb.size());
+      const Eigen::Vector2d pi = map.position2d(i);
+      for (NodeIndex k : nb) {
+        const Eigen::Vector2d d = map.position2d(k) - pi;
+        const double len = d.norm();
+        targets.push_back(k);
+        length.push_back(len);
+        ux.push_back(len > kMinEdgeLength ? d.x() / len : 0.0);
+        uy.push_back(len > kMinEdgeLength ? d.y() / len : 0.0);
+      }
+    }
+  }
+};
+
+const char* toString(UpdateStatus s) {
+  switch (s) {
+    case UpdateStatus::kAccepted: return "accepted";
+    case UpdateStatus::kReordered: return "reordered";
+    case UpdateStatus::kDroppedTooOld: return "dropped_too_old";
+    case UpdateStatus::kIgnoredSensor: return "ignored_sensor";
+    case UpdateStatus::kRejectedInvalid: return "rejected_invalid";
+  }
+  return "unknown";
+}
+
+double Belief::massOf(NodeIndex n) const {
+  auto it = std::lower_bound(nodes.begin(), nodes.end(), n);
+  return (it != nodes.end() && *it == n) ? masses[static_cast<std::size_t>(it - nodes.begin())] : 0.0;
+}
+
+TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topology::TopologicalMap> map,
+                                                     TpfParams params, std::uint64_t seed)
+    : map_(std::move(map)), params_(std::move(params)), seed_(seed), rng_(seed) {
+  if (!map_ || map_->numNodes() == 0) throw std::invalid_argument("TopologicalParticleFilter: empty map");
+  const std::string problem = params_.validate();
+  if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
+  graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion);
+  node_scratch_a_.assign(map_->numNodes(), 0.0);
+  node_scratch_b_.assign(map_->numNodes(), 0.0);
+  reset();
+}
+
+void TopologicalParticleFilter::reset() {
+  particles_.clear();
+  resampled_.clear();
+  weights_.clear();
+  touched_.clear();
+  belief_ = Belief();
+  unconnected_p_ = params_.unconnected_jump_probability;
+  belief_.unconnected_jump_probability = unconnected_p_;
+}
+
+// ------------------------------------------------------------------------------------------ equations ------
+double TopologicalParticleFilter::lambda(double projected_speed, double distance) {
+  // Eq. 6. A zero-length edge has no direction to move along: lambda 0 (no jump).
+  if (!(distance > kMinEdgeLength)) return 0.0;
+  return 2.0 * kLogHalf * std::max(0.0, projected_speed) / distance;
+}
+
+double TopologicalParticleFilter::edgeJumpProbability(double lambda, double dwell) {
+  return 1.0 - std::exp(lambda * std::max(0.0, dwell));
+}
+
+std::vector<double> TopologicalParticleFilter::transitionProbabilities(NodeIndex node, double vx, double vy,
+                                                                       double dwell) const {
+  const MotionGraph& g = *graph_;
+  const std::uint32_t begin = g.offsets.at(node), end = g.offsets.at(node + 1);
+  std::vector<double> out(end - begin, 0.0);
+  if (begin == end) return out;
+  if (params_.motion_model == MotionModel::kFixedLambda) {
+    // Khan et al. Eq. 2: r = 1 - exp(-lambda tau), target uniform among the connected nodes.
+    const double r = 1.0 - std::exp(-params_.fixed_lambda * std::max(0.0, dwell));
+    for (auto& p : out) p = r / static_cast<double>(out.size());
+    return out;
+  }
+  double sum_b = 0.0;
+  for (std::uint32_t e = begin; e < end; ++e) sum_b += std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
+  if (!(sum_b > 0.0)) return out;
+  for (std::uint32_t e = begin; e < end; ++e) {
+    const double b = std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
+    out[e - begin] = b * edgeJumpProbability(lambda(b, g.length[e]), dwell) / sum_b;
+  }
+  return out;
+}
+
+double TopologicalParticleFilter::jumpProbability(NodeIndex node, double vx, double vy, double dwell) const {
+  double s = 0.0;
+  for (double p : transitionProbabilities(node, vx, vy, dwell)) s += p;
+  return s;
+}
+
+double TopologicalParticleFilter::particleWeight(const Particle& p, double normalised_likelihood,
+                                                 const core::Observation& obs) const {
+  const SensorGamma gamma = params_.gammaFor(obs.sensor);
+  double w = gamma.node * normalised_likelihood;
+  if (params_.gamma_as_confidence) w += 1.0 - gamma.node;
+  if (obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity) {
+    const double vs = obs.velocity->norm();
+    const double sigma = std::max(0.5 * vs, params_.min_velocity_sigma);
+    const double speed = std::hypot(static_cast<double>(p.vx), static_cast<double>(p.vy));
+    const double z = (speed - vs) / sigma;
+    const double g = std::exp(-0.5 * z * z);  // Gaussian of Eq. 8, peak 1
+    // cos of the angle between the particle and the observed velocity; 0 (no preference) if either is zero.
+    const double denom = speed * vs;
+    const double cosang =
+        denom > 1e-12 ? (p.vx * obs.velocity->x() + p.vy * obs.velocity->y()) / denom : 0.0;
+    w += gamma.velocity * 0.25 * (g + 0.5 * (cosang + 1.0));
+  }
+  return w;
+}
+
+double TopologicalParticleFilter::jensenShannonDistance(const std::vector<std::pair<NodeIndex, double>>& p,
+                                                        const std::vector<std::pair<NodeIndex, double>>& q) {
+  auto sorted = [](std::vector<std::pair<NodeIndex, double>> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+  };
+  const auto a = sorted(p), b = sorted(q);
+  auto term = [](double x, double y) {  // x log2(2x / (x + y))
+    return x > 0.0 ? x * std::log2(2.0 * x / (x + y)) : 0.0;
+  };
+  double s = 0.0;
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    double x = 0.0, y = 0.0;
+    if (j == b.size() || (i < a.size() && a[i].first < b[j].first)) {
+      x = a[i++].second;
+    } else if (i == a.size() || b[j].first < a[i].first) {
+      y = b[j++].second;
+    } else {
+      x = a[i++].second;
+      y = b[j++].second;
+    }
+    s += term(x, y) + term(y, x);
+  }
+  return std::sqrt(std::clamp(0.5 * s, 0.0, 1.0));
+}
+
+double TopologicalParticleFilter::entropy(const std::vector<double>& probabilities) {
+  double h = 0.0;
+  for (double p : probabilities)
+    if (p > 0.0) h -= p * std::log(p);
+  return h;
+}
+
+// ----------------------------------------------------------------------------------------- algorithm ------
+UpdateResult TopologicalParticleFilter::reject(UpdateStatus status, std::string reason) {
+  switch (status) {
+    case UpdateStatus::kDroppedTooOld: ++counters_.dropped_too_old; break;
+    case UpdateStatus::kIgnoredSensor: ++counters_.ignored_sensor; break;
+    default: ++counters_.rejected_invalid; break;
+  }
+  UpdateResult r;
+  r.status = status;
+  r.reason = std::move(reason);
+  return r;
+}
+
+UpdateResult TopologicalParticleFilter::update(const core::Observation& obs) {
+  if (!params_.acceptsSensor(obs.sensor))
+    return reject(UpdateStatus::kIgnoredSensor, "sensor '" + obs.sensor + "' is not fused in this mode");
+  const std::string problem = core::validateObservation(obs, *map_);
+  if (!problem.empty()) return reject(UpdateStatus::kRejectedInvalid, problem);
+
+  UpdateResult result;
+  double dt = 0.0;
+  if (!belief_.initialised) {
+    initialise(obs);
+    belief_.initialised = true;
+    belief_.stamp = obs.stamp;
+    result.initialised = true;
+  } else if (obs.stamp < belief_.stamp) {
+    const double late = belief_.stamp - obs.stamp;
+    if (late > params_.reorder_window)
+      return reject(UpdateStatus::kDroppedTooOld, "observation " + std::to_string(late) +
+                                                      " s older than the last update (reorder window " +
+                                                      std::to_string(params_.reorder_window) + " s)");
+    result.status = UpdateStatus::kReordered;
+  } else {
+    dt = obs.stamp - belief_.stamp;
+  }
+  fuse(obs, dt, result);
+  if (result.status == UpdateStatus::kReordered) ++counters_.reordered;
+  else ++counters_.accepted;
+  ++belief_.observations;
+  belief_.stamp = std::max(belief_.stamp, obs.stamp);
+  return result;
+}
+
+bool TopologicalParticleFilter::predictTo(double stamp) {
+  if (!belief_.initialised || !std::isfinite(stamp) || !(stamp > belief_.stamp)) return false;
+  predict(stamp - belief_.stamp);
+  belief_.stamp = stamp;
+  belief_.reinitialised = false;
+  ++counters_.predictions;
+  recordBelief(false);
+  return true;
+}
+
+void TopologicalParticleFilter::initialise(const core::Observation& obs) {
+  // Eq. 1: q ~ L / sum L (uniform over the whole map when the observation does not identify the picker),
+  // v ~ N(mu_init, sigma^2_init) per component, tau ~ U(tau^-_init, tau^+_init).
+  const std::size_t n = params_.num_particles;
+  particles_.resize(n);
+  resampled_.resize(n);
+  weights_.resize(n);
+  std::normal_distribution<double> vel(params_.velocity_init_mean, std::sqrt(params_.velocity_init_variance));
+  std::vector<double> cumulative;
+  if (obs.identifying) {
+    cumulative.reserve(obs.likelihood.size());
+    double c = 0.0;
+    for (double l : obs.likelihood) cumulative.push_back(c += l);
+  }
+  const double span = params_.dwell_init_max - params_.dwell_init_min;
+  for (Particle& p : particles_) {
+    if (obs.identifying) {
+      const double u = uniform01(rng_) * cumulative.back();
+      std::size_t k = static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) -
+                                                cumulative.begin());
+      k = std::min(k, cumulative.size() - 1);
+      p.node = obs.nodes[k];
+    } else {
+      p.node = static_cast<NodeIndex>(rng_() % map_->numNodes());
+    }
+    p.vx = static_cast<float>(vel(rng_));
+    p.vy = static_cast<float>(vel(rng_));
+    p.dwell = params_.dwell_init_min + span * uniform01(rng_);
+  }
+  unconnected_p_ = params_.unconnected_jump_probability;
+}
+
+void TopologicalParticleFilter::predict(double dt) {
+  // Eqs. 2-7, one jump at most per particle and step; see the header for the reading of Eqs. 3 and 7.
+  const MotionGraph& g = *graph_;
+  const double inv_window = 1.0 / params_.velocity_window;
+  if (params_.motion_model == MotionModel::kFixedLambda) {
+    for (Particle& p : particles_) {
+      const double tau = p.dwell + dt;
+      const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
+      const double u = uniform01(rng_);
+      const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
+      if (begin == end || !(u < r)) {
+        p.dwell = tau;
+        continue;
+      }
+      // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
+      const std::uint32_t k = begin + std::min<std::uint32_t>(end - begin - 1,
+                                                              static_cast<std::uint32_t>((u / r) * (end - begin)));
+      p.node = g.targets[k];
+      p.dwell = 0.0;
+    }
+    return;
+  }
+  thread_local std::vector<double> contrib;
+  if (contrib.size() < g.max_degree) contrib.resize(g.max_degree);
+  for (Particle& p : particles_) {
+    const double tau = p.dwell + dt;
+    const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
+    const double vx = p.vx, vy = p.vy;
+    double sum_b = 0.0, sum_c = 0.0;
+    for (std::uint32_t e = begin; e < end; ++e) {
+      const double b = std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
+      double c = 0.0;
+      if (b > 0.0) {
+        // b (1 - exp(lambda tau)), lambda of Eq. 6 (length > 0 whenever b > 0).
+        c = b * (1.0 - std::exp(2.0 * kLogHalf * b / g.length[e] * tau));
+      }
+      contrib[e - begin] = c;
+      sum_b += b;
+      sum_c += c;
+    }
+    const double u = uniform01(rng_) * sum_b;  // jump with probability sum_c / sum_b (Eq. 2)
+    if (!(u < sum_c)) {
+      p.dwell = tau;
+      continue;
+    }
+    std::uint32_t e = begin;
+    double acc = contrib[0];
+    while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
+    const double pr = contrib[e - begin] / sum_b;  // Pr(q') of the transition taken
+    const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
+    const double ox = g.ux[e] * g.length[e] * inv_t, oy = g.uy[e] * g.length[e] * inv_t;
+    p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
+    p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
+    p.node = g.targets[e];
+    p.dwell = 0.0;
+  }
+}
+
+double TopologicalParticleFilter::observationJsd(const core::Observation& obs, double sum_likelihood) {
+  // JSD between the particles' node distribution Q and L / sum L over their joint support, in O(particles +
+  // support). node_scratch_b_ holds particle counts (cleared before returning).
+  std::vector<double>& count = node_scratch_b_;
+  touched_.clear();
+  for (const Particle& p : particles_) {
+    if (count[p.node] == 0.0) touched_.push_back(p.node);
+    count[p.node] += 1.0;
+  }
+  const double inv_n = 1.0 / static_cast<double>(particles_.size());
+  auto term = [](double x, double y) { return x > 0.0 ? x * std::log2(2.0 * x / (x + y)) : 0.0; };
+  double s = 0.0;
+  // node_scratch_a_ holds L (raw) at the observation's nodes.
+  for (NodeIndex n : touched_) {
+    const double q = count[n] * inv_n, l = node_scratch_a_[n] / sum_likelihood;
+    s += term(q, l) + term(l, q);
+  }
+  for (std::size_t j = 0; j < obs.nodes.size(); ++j)
+    if (count[obs.nodes[j]] == 0.0) s += obs.likelihood[j] / sum_likelihood;  // q = 0: l log2(2) = l
+  for (NodeIndex n : touched_) count[n] = 0.0;
+  return std::sqrt(std::clamp(0.5 * s, 0.0, 1.0));
+}
+
+void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, UpdateResult& result) {
+  predict(dt);  // Alg. 1 l. 4
+
+  double sum_l = 0.0, max_l = 0.0;
+  for (std::size_t j = 0; j < obs.nodes.size(); ++j) {
+    node_scratch_a_[obs.nodes[j]] = obs.likelihood[j];
+    sum_l += obs.likelihood[j];
+    max_l = std::max(max_l, obs.likelihood[j]);
+  }
+  belief_.jsd = observationJsd(obs, sum_l);  // Alg. 1 l. 5
+  belief_.reinitialised = false;
+  if (params_.jsd_monitor && obs.identifying && belief_.jsd > params_.jsd_threshold && !result.initialised) {
+    initialise(obs);  // Alg. 1 l. 6-9 (initialise() sets p_rj back to its initial value, l. 8)
+    belief_.reinitialised = true;
+    result.reinitialised = true;
+    ++counters_.reinitialisations;
+  }
+  const bool resampled = weightAndResample(obs, max_l);  // Alg. 1 l. 10-11
+  for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
+  if (!resampled) {
+    ++counters_.no_overlap;
+    result.reason = "no overlap between the observation and the particles: kept the predicted particles";
+    recordBelief(false);
+  }
+  // Alg. 1 l. 12-15
+  if (params_.entropy_gate && belief_.entropy < params_.entropy_threshold) unconnected_p_ = 0.0;
+  belief_.unconnected_jump_probability = unconnected_p_;
+}
+
+bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood) {
+  // Eq. 8 per particle, Eq. 9 masses in node_scratch_b_, Eq. 10 MAP.
+  const double inv_max = 1.0 / max_likelihood;
+  const SensorGamma gamma = params_.gammaFor(obs.sensor);
+  const bool velocity_term =
+      obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity;
+  const double base = params_.gamma_as_confidence ? 1.0 - gamma.node : 0.0;
+  double total = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Particle& p = particles_[i];
+    double w = gamma.node * node_scratch_a_[p.node] * inv_max + base;
+    if (velocity_term) w = particleWeight(p, node_scratch_a_[p.node] * inv_max, obs);
+    weights_[i] = w;
+    total += w;
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) return false;
+
+  std::vector<double>& mass = node_scratch_b_;
+  touched_.clear();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const NodeIndex n = particles_[i].node;
+    if (mass[n] == 0.0 && weights_[i] > 0.0) touched_.push_back(n);
+    mass[n] += weights_[i];
+  }
+  std::sort(touched_.begin(), touched_.end());
+  belief_.nodes.assign(touched_.begin(), touched_.end());
+  belief_.masses.resize(touched_.size());
+  double best = -1.0;
+  for (std::size_t k = 0; k < touched_.size(); ++k) {
+    const double m = mass[touched_[k]] / total;
+    belief_.masses[k] = m;
+    if (m > best) {
+      best = m;
+      belief_.map_node = touched_[k];
+    }
+    mass[touched_[k]] = 0.0;
+  }
+  for (const Particle& p : particles_) mass[p.node] = 0.0;  // nodes whose particles all weighed 0
+
+  resample();  // Eq. 11
+  addNoise();  // Eq. 12
+  // Entropy of the resampled particles (Alg. 1 l. 12).
+  touched_.clear();
+  for (const Particle& p : particles_) {
+    if (mass[p.node] == 0.0) touched_.push_back(p.node);
+    mass[p.node] += 1.0;
+  }
+  const double inv_n = 1.0 / static_cast<double>(particles_.size());
+  double h = 0.0;
+  for (NodeIndex n : touched_) {
+    const double q = mass[n] * inv_n;
+    h -= q * std::log(q);
+    mass[n] = 0.0;
+  }
+  belief_.entropy = h;
+  belief_.particle_count = particles_.size();
+  return true;
+}
+
+void TopologicalParticleFilter::resample() {
+  const std::size_t n = particles_.size();
+  double total = 0.0;
+  for (double w : weights_) total += w;
+  if (params_.resampling == ResamplingScheme::kLowVariance) {
+    const double step = total / static_cast<double>(n);
+    double target = uniform01(rng_) * step;
+    double acc = weights_[0];
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      while (acc <= target && j + 1 < n) acc += weights_[++j];
+      resampled_[i] = particles_[j];
+      target += step;
+    }
+  } else {
+    // Multinomial: cumulative weights and n independent draws (binary search).
+    std::vector<double>& cumulative = weights_;
+    double acc = 0.0;
+    for (double& w : cumulative) w = (acc += w);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double u = uniform01(rng_) * acc;
+      std::size_t j = static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) -
+                                               cumulative.begin());
+      resampled_[i] = particles_[std::min(j, n - 1)];
+    }
+  }
+  particles_.swap(resampled_);
+}
+
+void TopologicalParticleFilter::addNoise() {
+  // Eq. 12: q ~ U(N) with probability p_rj, v += N(mu_noise, sigma^2_noise), tau += U(tau^-, tau^+) (tau >= 0).
+  const double sigma = std::sqrt(params_.velocity_noise_variance);
+  const double mu = params_.velocity_noise_mean;
+  const double lo = params_.dwell_noise_min, span = params_.dwell_noise_max - params_.dwell_noise_min;
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (Particle& p : particles_) {
+    p.vx = static_cast<float>(p.vx + mu + sigma * normal(rng_));
+    p.vy = static_cast<float>(p.vy + mu + sigma * normal(rng_));
+    p.dwell = std::max(0.0, p.dwell + lo + span * uniform01(rng_));
+  }
+  if (unconnected_p_ > 0.0) {
+    // Which particles jump: geometric gaps between jumping particles (same law as one Bernoulli draw each).
+    std::geometric_distribution<std::size_t> gap(unconnected_p_);
+    const std::size_t n_nodes = map_->numNodes();
+    for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
+      particles_[i].node = static_cast<NodeIndex>(rng_() % n_nodes);
+      particles_[i].dwell = 0.0;
+    }
+  }
+}
+
+void TopologicalParticleFilter::recordBelief(bool /*with_weights*/) {
+  // Belief from the particles alone (equal weights): after a prediction, or when weighting was skipped.
+  std::vector<double>& count = node_scratch_b_;
+  touched_.clear();
+  for (const Particle& p : particles_) {
+    if (count[p.node] == 0.0) touched_.push_back(p.node);
+    count[p.node] += 1.0;
+  }
+  std::sort(touched_.begin(), touched_.end());
+  const double inv_n = 1.0 / static_cast<double>(particles_.size());
+  belief_.nodes.assign(touched_.begin(), touched_.end());
+  belief_.masses.resize(touched_.size());
+  double best = -1.0, h = 0.0;
+  for (std::size_t k = 0; k < touched_.size(); ++k) {
+    const double q = count[touched_[k]] * inv_n;
+    belief_.masses[k] = q;
+    h -= q * std::log(q);
+    if (q > best) {
+      best = q;
+      belief_.map_node = touched_[k];
+    }
+    count[touched_[k]] = 0.0;
+  }
+  belief_.entropy = h;
+  belief_.particle_count = particles_.size();
+}
+
+// ------------------------------------------------------------------------------------------- what-if ------
+TopologicalParticleFilter TopologicalParticleFilter::copyWithSeed(std::uint64_t seed) const {
+  TopologicalParticleFilter copy(*this);
+  if (seed != 0) {
+    copy.rng_.seed(seed);
+    copy.seed_ = seed;
+  }
+  return copy;
+}
+
+Belief TopologicalParticleFilter::predictAhead(double seconds, std::uint64_t seed) const {
+  TopologicalParticleFilter copy = copyWithSeed(seed);
+  if (std::isfinite(seconds) && seconds > 0.0) copy.predictTo(belief_.stamp + seconds);
+  return copy.belief_;
+}
+
+Belief TopologicalParticleFilter::posteriorUnder(const core::Observation& hypothetical, double seconds,
+                                                 std::uint64_t seed, UpdateResult* result) const {
+  TopologicalParticleFilter copy = copyWithSeed(seed);
+  if (std::isfinite(seconds) && seconds > 0.0) copy.predictTo(belief_.stamp + seconds);
+  core::Observation obs = hypothetical;
+  obs.stamp = copy.belief_.initialised ? copy.belief_.stamp : belief_.stamp;
+  const UpdateResult r = copy.update(obs);
+  if (result) *result = r;
+  return copy.belief_;
+}
+
+}  // namespace tpf
+}  // namespace picker_localisation

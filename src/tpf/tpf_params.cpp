@@ -1,0 +1,198 @@
+#include "picker_localisation/tpf/tpf_params.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace picker_localisation {
+namespace tpf {
+
+TpfParams::TpfParams() {
+  // Table I: gamma^GPS = (1, 1), gamma^LIDAR = (0.25, 0), gamma^RFID = (1, 0).
+  sensor_gammas["gnss"] = SensorGamma{1.0, 1.0};
+  sensor_gammas["lidar"] = SensorGamma{0.25, 0.0};
+  sensor_gammas["rfid"] = SensorGamma{1.0, 0.0};
+  // Not in the paper: UWB identifies like RFID; a camera is anonymous like LiDAR.
+  sensor_gammas["uwb"] = SensorGamma{1.0, 0.0};
+  sensor_gammas["camera"] = SensorGamma{0.25, 0.0};
+}
+
+SensorGamma TpfParams::gammaFor(const std::string& sensor) const {
+  auto it = sensor_gammas.find(sensor);
+  return it == sensor_gammas.end() ? default_gamma : it->second;
+}
+
+bool TpfParams::acceptsSensor(const std::string& sensor) const {
+  return accepted_sensors.empty() ||
+         std::find(accepted_sensors.begin(), accepted_sensors.end(), sensor) != accepted_sensors.end();
+}
+
+std::string TpfParams::validate() const {
+  auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (num_particles == 0) return "num_particles must be > 0";
+  if (!std::isfinite(velocity_init_mean) || !finite_nonneg(velocity_init_variance))
+    return "velocity_init_mean / velocity_init_variance must be finite, variance >= 0";
+  if (!std::isfinite(velocity_noise_mean) || !finite_nonneg(velocity_noise_variance))
+    return "velocity_noise_mean / velocity_noise_variance must be finite, variance >= 0";
+  if (!finite_nonneg(dwell_init_min) || !std::isfinite(dwell_init_max) || dwell_init_max < dwell_init_min)
+    return "dwell_init_min must be >= 0 and <= dwell_init_max";
+  if (!std::isfinite(dwell_noise_min) || !std::isfinite(dwell_noise_max) || dwell_noise_max < dwell_noise_min)
+    return "dwell_noise_min must be <= dwell_noise_max";
+  if (!finite_nonneg(fixed_lambda)) return "fixed_lambda must be >= 0";
+  if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window)) return "velocity_window must be >= 1";
+  if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell)) return "min_jump_dwell must be > 0";
+  if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma)) return "min_velocity_sigma must be > 0";
+  for (const auto& [name, g] : sensor_gammas)
+    if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity) || (gamma_as_confidence && g.node > 1.0))
+      return "sensor_gammas." + name + " must be finite and >= 0 (node <= 1 with gamma_as_confidence)";
+  if (!finite_nonneg(default_gamma.node) || !finite_nonneg(default_gamma.velocity) ||
+      (gamma_as_confidence && default_gamma.node > 1.0))
+    return "default_gamma must be finite and >= 0";
+  if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0)) return "jsd_threshold must be in [0, 1]";
+  if (!finite_nonneg(entropy_threshold)) return "entropy_threshold must be >= 0";
+  if (!(unconnected_jump_probability >= 0.0 && unconnected_jump_probability <= 1.0))
+    return "unconnected_jump_probability must be in [0, 1]";
+  if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate)) return "prediction_rate must be >= 0";
+  if (!finite_nonneg(reorder_window)) return "reorder_window must be >= 0";
+  return "";
+}
+
+namespace {
+
+template <typename T>
+void read(const YAML::Node& node, const char* key, T& value) {
+  const YAML::Node v = node[key];
+  if (!v) return;
+  try {
+    value = v.as<T>();
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(std::string("tpf params: bad value for '") + key + "': " + e.what());
+  }
+}
+
+SensorGamma readGamma(const YAML::Node& node, const std::string& key) {
+  SensorGamma g;
+  if (!node.IsMap()) throw std::runtime_error("tpf params: '" + key + "' must be a map {node: .., velocity: ..}");
+  read(node, "node", g.node);
+  read(node, "velocity", g.velocity);
+  return g;
+}
+
+}  // namespace
+
+TpfParams TpfParams::fromYaml(const YAML::Node& node) {
+  TpfParams p;
+  if (!node || node.IsNull()) return p;
+  if (!node.IsMap()) throw std::runtime_error("tpf params: top level must be a map");
+  if (node["method"]) p = presetForMethod(node["method"].as<std::string>(), p);
+
+  std::size_t particles = p.num_particles;
+  read(node, "num_particles", particles);
+  p.num_particles = particles;
+  if (node["resampling"]) {
+    const std::string r = node["resampling"].as<std::string>();
+    if (r == "low_variance") p.resampling = ResamplingScheme::kLowVariance;
+    else if (r == "multinomial") p.resampling = ResamplingScheme::kMultinomial;
+    else throw std::runtime_error("tpf params: resampling must be low_variance or multinomial, got '" + r + "'");
+  }
+  read(node, "velocity_init_mean", p.velocity_init_mean);
+  read(node, "velocity_init_variance", p.velocity_init_variance);
+  read(node, "dwell_init_min", p.dwell_init_min);
+  read(node, "dwell_init_max", p.dwell_init_max);
+  read(node, "velocity_noise_mean", p.velocity_noise_mean);
+  read(node, "velocity_noise_variance", p.velocity_noise_variance);
+  read(node, "dwell_noise_min", p.dwell_noise_min);
+  read(node, "dwell_noise_max", p.dwell_noise_max);
+  if (node["motion_model"]) {
+    const std::string m = node["motion_model"].as<std::string>();
+    if (m == "velocity") p.motion_model = MotionModel::kVelocity;
+    else if (m == "fixed_lambda") p.motion_model = MotionModel::kFixedLambda;
+    else throw std::runtime_error("tpf params: motion_model must be velocity or fixed_lambda, got '" + m + "'");
+  }
+  read(node, "fixed_lambda", p.fixed_lambda);
+  read(node, "velocity_window", p.velocity_window);
+  read(node, "min_jump_dwell", p.min_jump_dwell);
+  read(node, "directed_motion", p.directed_motion);
+  if (const YAML::Node g = node["sensor_gammas"]) {
+    if (!g.IsMap()) throw std::runtime_error("tpf params: 'sensor_gammas' must be a map");
+    for (const auto& kv : g) {
+      const std::string name = kv.first.as<std::string>();
+      p.sensor_gammas[name] = readGamma(kv.second, "sensor_gammas." + name);
+    }
+  }
+  if (const YAML::Node g = node["default_gamma"]) p.default_gamma = readGamma(g, "default_gamma");
+  read(node, "gamma_as_confidence", p.gamma_as_confidence);
+  read(node, "min_velocity_sigma", p.min_velocity_sigma);
+  read(node, "accepted_sensors", p.accepted_sensors);
+  read(node, "jsd_monitor", p.jsd_monitor);
+  read(node, "jsd_threshold", p.jsd_threshold);
+  read(node, "entropy_gate", p.entropy_gate);
+  read(node, "entropy_threshold", p.entropy_threshold);
+  read(node, "unconnected_jump_probability", p.unconnected_jump_probability);
+  read(node, "prediction_rate", p.prediction_rate);
+  read(node, "reorder_window", p.reorder_window);
+  const std::string problem = p.validate();
+  if (!problem.empty()) throw std::runtime_error("tpf params: " + problem);
+  return p;
+}
+
+TpfParams TpfParams::fromYamlFile(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  try {
+    return fromYaml(root);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+}
+
+std::vector<std::string> TpfParams::methodNames() {
+  return {"tpf", "khan_connected", "khan_unconnected", "no_monitor", "constant_speed"};
+}
+
+TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams& base) {
+  TpfParams p = base;
+  if (method == "tpf") return p;
+  if (method == "khan_connected" || method == "khan_unconnected") {
+    // Khan et al. [1]: GNSS only, fixed lambda 0.1, no monitors; "unconnected" lets a small share of the
+    // particles jump anywhere at every resampling (fixed p_rj), "connected" never.
+    p.motion_model = MotionModel::kFixedLambda;
+    p.fixed_lambda = 0.1;
+    p.accepted_sensors = {"gnss"};
+    p.jsd_monitor = false;
+    p.entropy_gate = false;
+    if (method == "khan_connected") p.unconnected_jump_probability = 0.0;
+    else if (p.unconnected_jump_probability <= 0.0) p.unconnected_jump_probability = 1e-3;
+    return p;
+  }
+  if (method == "no_monitor") {
+    // Stripped of both mechanisms of Sec. IV: no JSD re-initialisation and no (entropy-gated) jumps to
+    // unconnected nodes.
+    p.jsd_monitor = false;
+    p.entropy_gate = false;
+    p.unconnected_jump_probability = 0.0;
+    return p;
+  }
+  if (method == "constant_speed") {
+    // "does not estimate the particles velocity but uses a constant value, similar to [1]".
+    p.motion_model = MotionModel::kFixedLambda;
+    p.fixed_lambda = 0.1;
+    return p;
+  }
+  std::ostringstream names;
+  for (const auto& n : methodNames()) names << ' ' << n;
+  throw std::invalid_argument("unknown TPF method '" + method + "' (known:" + names.str() + ")");
+}
+
+const char* toString(MotionModel m) { return m == MotionModel::kVelocity ? "velocity" : "fixed_lambda"; }
+const char* toString(ResamplingScheme r) {
+  return r == ResamplingScheme::kLowVariance ? "low_variance" : "multinomial";
+}
+
+}  // namespace tpf
+}  // namespace picker_localisation
