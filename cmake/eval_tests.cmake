@@ -1,0 +1,2 @@
+pl_add_gtest(test_eval_metrics test/test_eval_metrics.cpp LIBS picker_localisation_eval)
+pl_add_gtest(test_ukf_metric test/test_ukf_metric.cpp LIBS picker_localisation_eval)
