@@ -1,0 +1,9 @@
+# Next-Best-Sense planner (Navigate-and-Seek Sec. V): ROS-free core, ROS node nbs_planner.
+add_library(picker_localisation_nbs
+  src/nbs/choquet.cpp
+  src/nbs/belief_source.cpp
+  src/nbs/next_best_sense_planner.cpp)
+target_link_libraries(picker_localisation_nbs PUBLIC picker_localisation_core)
+install(TARGETS picker_localisation_nbs
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
