@@ -41,9 +41,10 @@ struct LaserParams {
   double rate = 10.0;             // Hz
 };
 
-// Casts every beam of a laser at `sensor_pose` (map frame) against the scene; ranges noisy, +inf beyond
-// range_max, below range_min (after noise) reported as +inf too (REP 117 "too close" is -inf; we use +inf only
-// when nothing is hit and -inf when the hit is closer than range_min).
+// Casts every beam of a laser at `sensor_pose` (map frame) against the scene (first hit of circles and
+// segments), adds N(0, range_noise_std^2) to each hit (one draw per beam, hit or not). REP 117: +inf when
+// nothing is hit within range_max, -inf when the noisy hit is closer than range_min. The robot's own body is
+// not in the scene (the corner lasers look outwards).
 LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params, double stamp,
                     std::mt19937_64& rng);
 
