@@ -85,7 +85,6 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   TpfParams p;
   if (!node || node.IsNull()) return p;
   if (!node.IsMap()) throw std::runtime_error("tpf params: top level must be a map");
-  if (node["method"]) p = presetForMethod(node["method"].as<std::string>(), p);
 
   std::size_t particles = p.num_particles;
   read(node, "num_particles", particles);
@@ -132,6 +131,13 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "unconnected_jump_probability", p.unconnected_jump_probability);
   read(node, "prediction_rate", p.prediction_rate);
   read(node, "reorder_window", p.reorder_window);
+  if (node["method"]) {  // mode switches win
+    try {
+      p = presetForMethod(node["method"].as<std::string>(), p);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(std::string("tpf params: 'method': ") + e.what());
+    }
+  }
   const std::string problem = p.validate();
   if (!problem.empty()) throw std::runtime_error("tpf params: " + problem);
   return p;

@@ -88,11 +88,14 @@ struct TpfParams {
   std::string validate() const;
 
   // Reads a YAML node with the keys of config/tpf.yaml (missing keys keep the defaults above; a `method`
-  // key applies presetForMethod first). Throws std::runtime_error naming the key on a bad value.
+  // key applies presetForMethod last, so the preset's mode switches win over the file's). Throws
+  // std::runtime_error naming the key on a bad value.
   static TpfParams fromYaml(const YAML::Node& node);
   static TpfParams fromYamlFile(const std::string& path);
   // Table II method names: "tpf" (full filter, default), "khan_connected", "khan_unconnected", "no_monitor",
-  // "constant_speed". Throws std::invalid_argument for an unknown name.
+  // "constant_speed". A preset sets only its mode switches (motion_model, fixed_lambda, accepted_sensors,
+  // jsd_monitor, entropy_gate, unconnected_jump_probability) on top of `base`.
+  // Throws std::invalid_argument for an unknown name.
   static TpfParams presetForMethod(const std::string& method, const TpfParams& base = TpfParams());
   static std::vector<std::string> methodNames();
 };
