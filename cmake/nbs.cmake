@@ -4,6 +4,9 @@ add_library(picker_localisation_nbs
   src/nbs/belief_source.cpp
   src/nbs/next_best_sense_planner.cpp)
 target_link_libraries(picker_localisation_nbs PUBLIC picker_localisation_core)
+# The what-if view of a live TPF (in-process planning: experiment runner, tests).
+target_sources(picker_localisation_nbs PRIVATE src/nbs/tpf_belief_source.cpp)
+target_link_libraries(picker_localisation_nbs PUBLIC picker_localisation_tpf)
 install(TARGETS picker_localisation_nbs
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})

@@ -66,7 +66,7 @@ struct EnergyModel {
   double drive_energy_per_m = 150;  // J/m, traction at walking speed on grass
   double base_power = 60.0;         // W, computers and sensors, always on
   double sensing_power = 10.0;      // W, RFID reader transmitting
-  double speed = 0.5;               // m/s, mean driving speed along the graph (also sets the travel time)
+  double speed = 1.0;               // m/s, mean driving speed along the graph (also sets the travel time)
   double reserve = 0.1;             // fraction: candidates that would leave less are infeasible
   double energy(double distance, double sensing_time) const;  // J
   double levelAfter(double level, double distance, double sensing_time) const;
