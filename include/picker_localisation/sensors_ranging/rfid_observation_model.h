@@ -5,9 +5,9 @@
 // within the antenna's read range: L(n) = 1 for every node n with |n - antenna| <= read_range and (for a
 // directional antenna) |bearing(n) - yaw| <= beam_half_angle; other nodes 0 (not listed). When no node
 // qualifies, the node nearest to the antenna gets L = 1 (an observation is never empty).
-// Negative model (configurable): while an antenna is reading (it produced a read of any tag within
-// `negative_window` s), every picker with RFID tags that this antenna has not read within `negative_window`
-// gets, at most once per `negative_period` s, a non-identifying-by-read but identifying-by-id Observation
+// Negative model (configurable): while an antenna is reading (it has produced reads with gaps shorter than
+// `negative_window` s for at least `negative_window` s), every picker with RFID tags that this antenna has not read within `negative_window`
+// gets, at most once per `negative_period` s, an identifying Observation (sent with each read)
 // with L(n) = 1 - p_detect inside the read region and L(n) = 1 for every other map node (all map nodes are
 // listed, because unlisted nodes mean L = 0). Limitation: an antenna that reads no tag at all is not known
 // to be reading (RfidReading has no "inventory round" event), so it gives no negative information.
@@ -86,6 +86,7 @@ class RfidObservationModel {
   std::shared_ptr<const topology::TopologicalMap> map_;
   RfidModelOptions options_;
   std::map<std::string, double> antenna_last_stamp_;                            // antenna -> newest read
+  std::map<std::string, double> antenna_session_start_;  // antenna -> first read of its current reading spell
   std::map<std::pair<std::string, std::string>, double> last_read_;             // (antenna, picker) -> stamp
   std::map<std::pair<std::string, std::string>, double> last_negative_;         // (antenna, picker) -> stamp
   RfidCounters counters_;

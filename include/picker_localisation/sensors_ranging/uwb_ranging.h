@@ -106,7 +106,6 @@ class UwbRanging {
   struct TagState {
     std::string picker_id;
     RangeHistogramFilter filter;
-    std::optional<Eigen::Isometry2d> last_robot_pose;  // robot pose of the last RHF update
     double last_stamp = -1e300;                         // newest accepted range
     std::optional<Batch> batch;
     explicit TagState(const RhfOptions& o) : filter(o) {}

@@ -1,0 +1,20 @@
+# sensors_ranging: GNSS ingestion, RFID ranging, UWB ranging with the Range Histogram Filter.
+# ROS-free core library (namespace picker_localisation::sensors).
+add_library(picker_localisation_sensors_ranging
+  src/sensors_ranging/geodetic_datum.cpp
+  src/sensors_ranging/gnss_ingest.cpp
+  src/sensors_ranging/rfid_observation_model.cpp
+  src/sensors_ranging/range_histogram_filter.cpp
+  src/sensors_ranging/uwb_ranging.cpp)
+target_link_libraries(picker_localisation_sensors_ranging PUBLIC picker_localisation_core)
+install(TARGETS picker_localisation_sensors_ranging ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+if(benchmark_FOUND)
+  if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/tools/bench_rhf.cpp)
+    add_executable(bench_rhf src/tools/bench_rhf.cpp)
+    target_link_libraries(bench_rhf picker_localisation_sensors_ranging benchmark::benchmark)
+    set_target_properties(bench_rhf PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+    install(TARGETS bench_rhf RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+  endif()
+endif()

@@ -1,0 +1,143 @@
+#include "picker_localisation/sensors_ranging/gnss_ingest.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace picker_localisation {
+namespace sensors {
+
+const char* toString(GnssRejection r) {
+  switch (r) {
+    case GnssRejection::kNone: return "accepted";
+    case GnssRejection::kNoFix: return "no_fix";
+    case GnssRejection::kNotFinite: return "not_finite";
+    case GnssRejection::kNegativeCovariance: return "negative_covariance";
+    case GnssRejection::kOutOfOrder: return "out_of_order";
+    case GnssRejection::kImpossibleJump: return "impossible_jump";
+  }
+  return "unknown";
+}
+
+GnssIngest::GnssIngest(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map,
+                       GeodeticDatum datum, GnssIngestOptions options)
+    : picker_id_(std::move(picker_id)), map_(std::move(map)), datum_(std::move(datum)), options_(options) {
+  if (!map_) throw std::invalid_argument("GnssIngest: no map");
+}
+
+bool GnssIngest::inBlackout(double now) const {
+  return last_ && now - last_->stamp > options_.blackout_timeout;
+}
+
+double GnssIngest::ageOfLastFix(double now) const {
+  return last_ ? now - last_->stamp : std::numeric_limits<double>::infinity();
+}
+
+GnssResult GnssIngest::process(const GnssFix& fix) {
+  GnssResult result;
+  ++counters_.received;
+  auto reject = [&](GnssRejection r, const std::string& why, std::size_t& counter) {
+    result.rejection = r;
+    result.reason = why;
+    ++counter;
+    return result;
+  };
+  if (!std::isfinite(fix.stamp) || !std::isfinite(fix.latitude) || !std::isfinite(fix.longitude))
+    return reject(GnssRejection::kNotFinite, "stamp, latitude or longitude is NaN/Inf", counters_.not_finite);
+  if (std::abs(fix.latitude) > 90.0 || std::abs(fix.longitude) > 180.0)
+    return reject(GnssRejection::kNotFinite, "latitude / longitude out of range", counters_.not_finite);
+  if (fix.status < 0) return reject(GnssRejection::kNoFix, "status NO_FIX", counters_.no_fix);
+
+  // Horizontal covariance (ENU east-north block of the row-major 3x3).
+  Eigen::Matrix2d c_en;
+  if (fix.covariance_type <= 0) {
+    c_en = Eigen::Matrix2d::Identity() * options_.default_sigma * options_.default_sigma;
+  } else {
+    c_en << fix.covariance[0], fix.covariance[1], fix.covariance[3], fix.covariance[4];
+    if (!c_en.allFinite())
+      return reject(GnssRejection::kNotFinite, "covariance is NaN/Inf", counters_.not_finite);
+    if (c_en(0, 0) < 0.0 || c_en(1, 1) < 0.0)
+      return reject(GnssRejection::kNegativeCovariance, "negative variance in the covariance",
+                    counters_.negative_covariance);
+    // DIAGONAL_KNOWN: off-diagonal terms are meaningless by definition.
+    if (fix.covariance_type == 2) c_en(0, 1) = c_en(1, 0) = 0.0;
+    c_en = 0.5 * (c_en + c_en.transpose());
+    const double tol = 1e-9 * std::max(1.0, c_en.trace());
+    if (c_en.determinant() < -tol)
+      return reject(GnssRejection::kNegativeCovariance, "horizontal covariance is not positive semi-definite",
+                    counters_.negative_covariance);
+  }
+  // Floor each axis (the likelihood also floors the eigenvalues).
+  const double floor = options_.min_sigma * options_.min_sigma;
+  c_en(0, 0) = std::max(c_en(0, 0), floor);
+  c_en(1, 1) = std::max(c_en(1, 1), floor);
+  const Eigen::Matrix2d c_map = datum_.enuToMap(c_en);
+  const Eigen::Vector2d p = datum_.toMap(fix.latitude, fix.longitude, fix.altitude);
+  if (!p.allFinite()) return reject(GnssRejection::kNotFinite, "projection gave NaN/Inf", counters_.not_finite);
+  result.position = p;
+
+  if (last_ && fix.stamp <= last_->stamp) {
+    std::ostringstream s;
+    s << "stamp " << fix.stamp << " s is not after the last accepted fix (" << last_->stamp << " s)";
+    return reject(GnssRejection::kOutOfOrder, s.str(), counters_.out_of_order);
+  }
+
+  bool after_blackout = false;
+  if (last_) {
+    const double dt = fix.stamp - last_->stamp;
+    after_blackout = dt > options_.blackout_timeout;
+    if (!after_blackout && options_.jump_gate_sigmas > 0.0) {
+      const Eigen::Vector2d d = p - last_->position;
+      const double reach = options_.max_speed * dt;
+      const Eigen::Matrix2d c = last_->covariance + c_map + reach * reach * Eigen::Matrix2d::Identity();
+      const double m2 = d.dot(c.inverse() * d);
+      if (m2 > options_.jump_gate_sigmas * options_.jump_gate_sigmas) {
+        ++consecutive_jumps_;
+        if (consecutive_jumps_ < options_.jump_reset_count || options_.jump_reset_count == 0) {
+          std::ostringstream s;
+          s << "jump of " << d.norm() << " m in " << dt << " s fails the gate (Mahalanobis " << std::sqrt(m2)
+            << " > " << options_.jump_gate_sigmas << ")";
+          return reject(GnssRejection::kImpossibleJump, s.str(), counters_.impossible_jump);
+        }
+        // Persistent "jump": the reference was the outlier (or the picker really moved): re-anchor.
+        ++counters_.gate_resets;
+        window_.clear();
+      }
+    }
+  }
+  consecutive_jumps_ = 0;
+  if (after_blackout) {
+    result.blackout_ended = fix.stamp - last_->stamp;
+    ++counters_.blackouts;
+    counters_.longest_blackout = std::max(counters_.longest_blackout, result.blackout_ended);
+    window_.clear();  // the velocity must not span the gap
+  }
+
+  last_ = Accepted{fix.stamp, p, c_map};
+  window_.push_back(*last_);
+  while (window_.size() > std::max<std::size_t>(options_.velocity_window, 1)) window_.pop_front();
+  ++counters_.accepted;
+
+  core::Observation obs;
+  obs.stamp = fix.stamp;
+  obs.sensor = options_.sensor;
+  obs.picker_id = picker_id_;
+  obs.identifying = true;
+  core::GaussianLikelihoodOptions lo;
+  lo.cutoff_sigmas = options_.cutoff_sigmas;
+  lo.min_sigma = options_.min_sigma;
+  lo.max_nodes = options_.max_nodes;
+  core::setGaussianLikelihood(obs, *map_, p, c_map, lo);
+  if (options_.velocity_window >= 2 && window_.size() >= 2) {
+    const double span = window_.back().stamp - window_.front().stamp;
+    if (span > 0.0) obs.velocity = (window_.back().position - window_.front().position) / span;
+  }
+  result.observation = std::move(obs);
+  return result;
+}
+
+}  // namespace sensors
+}  // namespace picker_localisation

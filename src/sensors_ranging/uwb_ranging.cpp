@@ -1,0 +1,179 @@
+#include "picker_localisation/sensors_ranging/uwb_ranging.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace picker_localisation {
+namespace sensors {
+
+std::optional<Eigen::Vector2d> relativePositionFromPathDifference(double r, double p, double d, bool positive_y) {
+  if (!std::isfinite(r) || !std::isfinite(p) || !std::isfinite(d) || d <= 0.0 || r < 0.0 || std::abs(p) > d)
+    return std::nullopt;
+  const double x = (d * d + 2.0 * r * p - p * p) / (2.0 * d);
+  const double y2 = r * r - x * x;
+  const double y = y2 > 0.0 ? std::sqrt(y2) : 0.0;
+  return Eigen::Vector2d(x, positive_y ? y : -y);
+}
+
+double pathDifferenceFromPhase(double phase_difference, double wavelength) {
+  return phase_difference * wavelength / (2.0 * M_PI);
+}
+
+Eigen::Vector2d relativePositionFromAngle(double r, double angle) {
+  return {r * std::cos(angle), r * std::sin(angle)};
+}
+
+Eigen::Matrix2d relativePositionCovariance(double r, double angle, double range_variance, double angle_sigma) {
+  Eigen::Matrix2d rot;
+  rot << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+  const Eigen::Vector2d d(std::max(range_variance, 0.0), r * r * angle_sigma * angle_sigma);
+  return rot * d.asDiagonal() * rot.transpose();
+}
+
+const char* toString(UwbRejection r) {
+  switch (r) {
+    case UwbRejection::kNone: return "accepted";
+    case UwbRejection::kUnknownTag: return "unknown_tag";
+    case UwbRejection::kNotFinite: return "not_finite";
+    case UwbRejection::kNegativeRange: return "negative_range";
+    case UwbRejection::kOutOfRange: return "out_of_range";
+    case UwbRejection::kOutOfOrder: return "out_of_order";
+  }
+  return "unknown";
+}
+
+UwbRanging::UwbRanging(core::PickerRegistry registry, std::shared_ptr<const topology::TopologicalMap> map,
+                       UwbRangingOptions options)
+    : registry_(std::move(registry)), map_(std::move(map)), options_(std::move(options)) {
+  if (!map_) throw std::invalid_argument("UwbRanging: no map");
+  if (options_.pdoa_mode != "ignore" && options_.pdoa_mode != "bearing" && options_.pdoa_mode != "direct")
+    throw std::invalid_argument("UwbRanging: pdoa_mode must be ignore, bearing or direct");
+  RangeHistogramFilter check(options_.rhf);  // validates the RHF options now rather than at the first range
+}
+
+const RangeHistogramFilter* UwbRanging::filter(const std::string& tag_id) const {
+  auto it = tags_.find(tag_id);
+  return (it == tags_.end() || !it->second.filter.initialised()) ? nullptr : &it->second.filter;
+}
+
+UwbRejection UwbRanging::addRange(const UwbRangeInput& in, const Eigen::Isometry2d& robot_pose,
+                                  std::vector<core::Observation>* out, std::string* reason) {
+  ++counters_.received;
+  auto reject = [&](UwbRejection r, const std::string& why, std::size_t& counter) {
+    ++counter;
+    if (reason) *reason = why;
+    return r;
+  };
+  if (!std::isfinite(in.stamp) || !std::isfinite(in.range) || !std::isfinite(in.variance) ||
+      !in.anchor_in_robot.matrix().allFinite() || !robot_pose.matrix().allFinite() ||
+      (in.pdoa_angle && !std::isfinite(*in.pdoa_angle)))
+    return reject(UwbRejection::kNotFinite, "stamp, range, variance, angle or pose is NaN/Inf", counters_.not_finite);
+  const std::optional<std::string> picker = registry_.pickerForUwbTag(in.tag_id);
+  if (!picker) return reject(UwbRejection::kUnknownTag, "unknown tag '" + in.tag_id + "'", counters_.unknown_tag);
+  if (in.range < 0.0) {
+    std::ostringstream s;
+    s << "negative range " << in.range << " m";
+    return reject(UwbRejection::kNegativeRange, s.str(), counters_.negative_range);
+  }
+  if (in.range > options_.max_range) {
+    std::ostringstream s;
+    s << "range " << in.range << " m beyond max_range " << options_.max_range << " m";
+    return reject(UwbRejection::kOutOfRange, s.str(), counters_.out_of_range);
+  }
+  auto it = tags_.find(in.tag_id);
+  if (it == tags_.end()) it = tags_.emplace(in.tag_id, TagState(options_.rhf)).first;
+  TagState& st = it->second;
+  st.picker_id = *picker;
+  if (in.stamp < st.last_stamp) {
+    std::ostringstream s;
+    s << "stamp " << in.stamp << " s is older than the tag's newest range (" << st.last_stamp << " s)";
+    return reject(UwbRejection::kOutOfOrder, s.str(), counters_.out_of_order);
+  }
+  ++counters_.accepted;
+  st.last_stamp = in.stamp;
+  if (st.batch && (in.stamp - st.batch->first_stamp > options_.batch_window ||
+                   std::find(st.batch->anchors.begin(), st.batch->anchors.end(), in.anchor_id) != st.batch->anchors.end()))
+    processBatch(in.tag_id, st, out);
+
+  const double variance = in.variance > 0.0 ? in.variance : options_.rhf.default_range_sigma * options_.rhf.default_range_sigma;
+  const double anchor_yaw = std::atan2(in.anchor_in_robot.linear()(1, 0), in.anchor_in_robot.linear()(0, 0));
+  if (in.pdoa_angle && options_.pdoa_mode == "direct") {
+    // Seed 002: range + angle -> relative position in the anchor frame -> map frame.
+    const Eigen::Isometry2d anchor_in_map = robot_pose * in.anchor_in_robot;
+    const Eigen::Vector2d p = anchor_in_map * relativePositionFromAngle(in.range, *in.pdoa_angle);
+    const Eigen::Matrix2d c_anchor =
+        relativePositionCovariance(in.range, *in.pdoa_angle, variance, options_.pdoa_angle_sigma);
+    const Eigen::Matrix2d c = anchor_in_map.linear() * c_anchor * anchor_in_map.linear().transpose();
+    if (out) out->push_back(makeObservation(*picker, in.robot_id, in.stamp, p, c));
+    ++counters_.observations;
+    return UwbRejection::kNone;
+  }
+  if (!st.batch) {
+    st.batch = Batch();
+    st.batch->first_stamp = in.stamp;
+  }
+  Batch& b = *st.batch;
+  b.last_stamp = in.stamp;
+  b.robot_id = in.robot_id;
+  b.robot_pose = robot_pose;
+  b.anchors.push_back(in.anchor_id);
+  b.ranges.push_back({in.anchor_in_robot.translation(), in.range, variance});
+  if (in.pdoa_angle && options_.pdoa_mode == "bearing")
+    b.pdoa_bearings.push_back({in.anchor_in_robot.translation(), *in.pdoa_angle + anchor_yaw, options_.pdoa_angle_sigma});
+  return UwbRejection::kNone;
+}
+
+void UwbRanging::addBearings(const CameraBearings& bearings) {
+  if (!std::isfinite(bearings.stamp)) return;
+  bearings_.push_back(bearings);
+  counters_.bearings += bearings.bearings.size();
+  // Keep the list short: drop sets far older than the newest one.
+  const double newest = bearings.stamp;
+  bearings_.erase(std::remove_if(bearings_.begin(), bearings_.end(),
+                                 [&](const CameraBearings& c) { return c.stamp < newest - 4.0 * options_.bearing_max_age; }),
+                  bearings_.end());
+}
+
+void UwbRanging::flush(double now, std::vector<core::Observation>* out) {
+  for (auto& [tag, st] : tags_)
+    if (st.batch && now - st.batch->first_stamp > options_.batch_window) processBatch(tag, st, out);
+}
+
+void UwbRanging::processBatch(const std::string& tag, TagState& st, std::vector<core::Observation>* out) {
+  Batch b = std::move(*st.batch);
+  st.batch.reset();
+  (void)tag;
+  if (st.filter.initialised() && b.last_stamp - st.filter.lastStamp() > options_.reset_after) st.filter.reset();
+  std::vector<BearingMeasurement> bearings = b.pdoa_bearings;
+  // Camera bearings: only the set nearest in time within bearing_max_age (one image per camera frame).
+  const CameraBearings* best = nullptr;
+  for (const CameraBearings& c : bearings_) {
+    const double age = std::abs(b.last_stamp - c.stamp);
+    if (age <= options_.bearing_max_age && (!best || age < std::abs(b.last_stamp - best->stamp))) best = &c;
+  }
+  if (best) bearings.insert(bearings.end(), best->bearings.begin(), best->bearings.end());
+  std::optional<RhfEstimate> est = st.filter.update(b.last_stamp, b.ranges, bearings, b.robot_pose);
+  if (!est) return;
+  ++counters_.updates;
+  if (out) out->push_back(makeObservation(st.picker_id, b.robot_id, b.last_stamp, est->position, est->covariance));
+  ++counters_.observations;
+}
+
+core::Observation UwbRanging::makeObservation(const std::string& picker_id, const std::string& robot_id, double stamp,
+                                              const Eigen::Vector2d& p_map, const Eigen::Matrix2d& c_map) const {
+  core::Observation obs;
+  obs.stamp = stamp;
+  obs.sensor = options_.sensor;
+  obs.robot_id = robot_id;
+  obs.picker_id = picker_id;
+  obs.identifying = true;
+  core::GaussianLikelihoodOptions lo;
+  lo.min_sigma = options_.min_sigma;
+  lo.cutoff_sigmas = options_.cutoff_sigmas;
+  core::setGaussianLikelihood(obs, *map_, p_map, c_map, lo);
+  return obs;
+}
+
+}  // namespace sensors
+}  // namespace picker_localisation
