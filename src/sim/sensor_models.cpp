@@ -49,21 +49,41 @@ LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const La
   scan.angle_max = params.angle_min + (n - 1) * params.angle_increment;
   scan.ranges.assign(static_cast<std::size_t>(n), std::numeric_limits<float>::infinity());
   const Eigen::Vector2d o = sensor_pose.position();
-  // Only obstacles that can be within range.
-  std::vector<Circle> circles;
+  std::vector<double> best(static_cast<std::size_t>(n), kInf);
+  auto beamDir = [&](int i) {
+    const double ang = sensor_pose.yaw + params.angle_min + i * params.angle_increment;
+    return Eigen::Vector2d(std::cos(ang), std::sin(ang));
+  };
+  // Circles: only the beams inside each circle's angular extent are tested.
   const double reach = params.range_max + 1.0;
-  for (const auto& c : scene.circles)
-    if ((c.centre - o).norm() - c.radius < reach) circles.push_back(c);
-  std::vector<Segment> segments;
-  for (const auto& s : scene.segments)
-    if (std::min((s.a - o).norm(), (s.b - o).norm()) < reach + (s.b - s.a).norm()) segments.push_back(s);
+  for (const auto& c : scene.circles) {
+    const Eigen::Vector2d v = c.centre - o;
+    const double d = v.norm();
+    if (d - c.radius > reach || d <= c.radius) continue;
+    const double half = std::asin(std::min(1.0, c.radius / d));
+    const double rel = std::remainder(std::atan2(v.y(), v.x()) - sensor_pose.yaw, 2.0 * M_PI);
+    for (double shift : {-2.0 * M_PI, 0.0, 2.0 * M_PI}) {
+      const double lo = (rel + shift - half - params.angle_min) / params.angle_increment;
+      const double hi = (rel + shift + half - params.angle_min) / params.angle_increment;
+      const int i0 = std::max(0, static_cast<int>(std::ceil(lo)));
+      const int i1 = std::min(n - 1, static_cast<int>(std::floor(hi)));
+      for (int i = i0; i <= i1; ++i) {
+        const double r = rayCircle(o, beamDir(i), c);
+        if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
+      }
+    }
+  }
+  // Segments (few: other robots' footprints): every beam.
+  for (const auto& sg : scene.segments) {
+    if (std::min((sg.a - o).norm(), (sg.b - o).norm()) > reach + (sg.b - sg.a).norm()) continue;
+    for (int i = 0; i < n; ++i) {
+      const double r = raySegment(o, beamDir(i), sg);
+      if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
+    }
+  }
   std::normal_distribution<double> noise(0.0, params.range_noise_std);
   for (int i = 0; i < n; ++i) {
-    const double ang = sensor_pose.yaw + params.angle_min + i * params.angle_increment;
-    const Eigen::Vector2d d(std::cos(ang), std::sin(ang));
-    double r = kInf;
-    for (const auto& c : circles) r = std::min(r, rayCircle(o, d, c));
-    for (const auto& s : segments) r = std::min(r, raySegment(o, d, s));
+    double r = best[static_cast<std::size_t>(i)];
     // Noise is drawn for every beam so the stream does not depend on what is hit.
     const double eps = params.range_noise_std > 0.0 ? noise(rng) : 0.0;
     if (!std::isfinite(r)) continue;
