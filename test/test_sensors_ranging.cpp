@@ -1,0 +1,589 @@
+// sensors_ranging core classes against hand-computed values: datum, GNSS ingest, RFID model, Range Histogram
+// Filter (seed 004 Eqs. 2-7), UWB ranging and the two-antenna PDoA relative position (seed 002). No roscore.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/range_histogram_filter.h"
+#include "picker_localisation/sensors_ranging/rfid_observation_model.h"
+#include "picker_localisation/sensors_ranging/uwb_ranging.h"
+
+using namespace picker_localisation;
+using namespace picker_localisation::sensors;
+using topology::NodeIndex;
+
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Nodes on a square lattice with `spacing` m over [-half, half]^2, named n_<i>_<j>; no edges needed here.
+std::shared_ptr<const topology::TopologicalMap> latticeMap(double half, double spacing) {
+  std::vector<topology::Node> nodes;
+  const int n = static_cast<int>(std::lround(2.0 * half / spacing));
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      topology::Node node;
+      node.name = "n_" + std::to_string(i) + "_" + std::to_string(j);
+      node.position = Eigen::Vector3d(-half + i * spacing, -half + j * spacing, 0.0);
+      nodes.push_back(node);
+    }
+  return std::make_shared<const topology::TopologicalMap>(topology::TopologicalMap::build("lattice", nodes, {}));
+}
+
+double likelihoodAt(const core::Observation& obs, NodeIndex n) {
+  auto it = std::find(obs.nodes.begin(), obs.nodes.end(), n);
+  return it == obs.nodes.end() ? 0.0 : obs.likelihood[static_cast<std::size_t>(it - obs.nodes.begin())];
+}
+
+NodeIndex nodeAt(const topology::TopologicalMap& map, double x, double y) {
+  return map.nearestNode(Eigen::Vector2d(x, y));
+}
+
+core::PickerRegistry twoPickers() {
+  return core::PickerRegistry::parse(
+      "pickers:\n"
+      "  - {id: picker_1, gnss_topic: /pickers/picker_1/fix, rfid_tags: [rfid_1], uwb_tag: uwb_1}\n"
+      "  - {id: picker_2, gnss_topic: /pickers/picker_2/fix, rfid_tags: [rfid_2], uwb_tag: uwb_2}\n");
+}
+
+DatumConfig riseholmeDatum(double heading_deg = 0.0) {
+  DatumConfig c;
+  c.latitude = 53.268;
+  c.longitude = -0.524;
+  c.heading = heading_deg * M_PI / 180.0;
+  return c;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------------
+// Datum
+
+TEST(GeodeticDatum, LocalCartesianAgainstEllipsoidRadii) {
+  GeodeticDatum datum(riseholmeDatum());
+  EXPECT_NEAR(datum.toMap(53.268, -0.524).norm(), 0.0, 1e-6);
+  // Hand values: WGS84 a = 6378137, f = 1/298.257223563; meridional radius M and prime vertical radius N at
+  // the origin; 0.001 deg of latitude ~ M * 0.001 * pi / 180 north, 0.001 deg of longitude ~ N cos(lat) * ...
+  const double a = 6378137.0, f = 1.0 / 298.257223563, e2 = f * (2.0 - f);
+  const double phi = 53.268 * M_PI / 180.0, s2 = std::sin(phi) * std::sin(phi);
+  const double M = a * (1.0 - e2) / std::pow(1.0 - e2 * s2, 1.5), N = a / std::sqrt(1.0 - e2 * s2);
+  const double north = M * 0.001 * M_PI / 180.0, east = N * std::cos(phi) * 0.001 * M_PI / 180.0;
+  const Eigen::Vector2d pn = datum.toMap(53.269, -0.524);
+  EXPECT_NEAR(pn.x(), 0.0, 0.01);
+  EXPECT_NEAR(pn.y(), north, 0.05);  // 111.3 m
+  const Eigen::Vector2d pe = datum.toMap(53.268, -0.523);
+  EXPECT_NEAR(pe.x(), east, 0.05);   // 66.8 m
+  EXPECT_NEAR(pe.y(), 0.0, 0.05);
+  // Inverse.
+  const Eigen::Vector2d ll = datum.toLatLon(Eigen::Vector2d(120.0, -35.0));
+  EXPECT_NEAR((datum.toMap(ll.x(), ll.y()) - Eigen::Vector2d(120.0, -35.0)).norm(), 0.0, 1e-6);
+}
+
+TEST(GeodeticDatum, HeadingRotatesPositionsAndCovariances) {
+  GeodeticDatum d90(riseholmeDatum(90.0));  // map x points north, map y west
+  const Eigen::Vector2d p = d90.toMap(53.269, -0.524);  // ~111 m north
+  EXPECT_NEAR(p.x(), GeodeticDatum(riseholmeDatum()).toMap(53.269, -0.524).y(), 1e-6);
+  EXPECT_NEAR(p.y(), 0.0, 0.01);
+  const Eigen::Vector2d pe = d90.toMap(53.268, -0.523);  // east -> map -y
+  EXPECT_LT(pe.y(), -60.0);
+  Eigen::Matrix2d c_en = Eigen::Vector2d(4.0, 1.0).asDiagonal();  // 2 m east, 1 m north
+  const Eigen::Matrix2d c = d90.enuToMap(c_en);
+  EXPECT_NEAR(c(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(c(1, 1), 4.0, 1e-12);
+  EXPECT_NEAR(c(0, 1), 0.0, 1e-12);
+}
+
+TEST(GeodeticDatum, UtmKindKeepsDistancesAndParsesYaml) {
+  // UTM origin at a hand-picked easting / northing; compare a 100 m baseline with the local-cartesian one
+  // (UTM scale factor near 0.9996-1.0004 -> < 0.1 m on 100 m; grid convergence only rotates).
+  const GeodeticDatum utm = GeodeticDatum::parse(
+      "datum: {type: utm, utm_zone: 30, utm_north: true, utm_easting: 665000.0, utm_northing: 5905000.0}\n");
+  const GeodeticDatum lc(riseholmeDatum());
+  const double d_utm = (utm.toMap(53.268, -0.524) - utm.toMap(53.2688, -0.5228)).norm();
+  const double d_lc = (lc.toMap(53.268, -0.524) - lc.toMap(53.2688, -0.5228)).norm();
+  EXPECT_GT(d_lc, 100.0);
+  EXPECT_NEAR(d_utm, d_lc, 0.1);
+  const Eigen::Vector2d ll = utm.toLatLon(utm.toMap(53.268, -0.524));
+  EXPECT_NEAR(ll.x(), 53.268, 1e-9);
+  EXPECT_NEAR(ll.y(), -0.524, 1e-9);
+  // The shipped config parses and is the Riseholme origin.
+  const GeodeticDatum shipped = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  EXPECT_NEAR(shipped.config().latitude, 53.268, 1e-9);
+  EXPECT_NEAR(shipped.config().longitude, -0.524, 1e-9);
+  // Bad files: one line naming the field.
+  EXPECT_THROW(GeodeticDatum::parse("datum: {type: local_cartesian, longitude: 1.0}\n"), std::runtime_error);
+  EXPECT_THROW(GeodeticDatum::parse("datum: {type: mercator, latitude: 1, longitude: 1}\n"), std::runtime_error);
+  EXPECT_THROW(GeodeticDatum::parse("datum: {latitude: 95, longitude: 1}\n"), std::runtime_error);
+  EXPECT_THROW(GeodeticDatum::parse("nodatum: 1\n"), std::runtime_error);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// GNSS
+
+namespace {
+struct GnssFixture {
+  std::shared_ptr<const topology::TopologicalMap> map = latticeMap(20.0, 1.0);
+  GeodeticDatum datum{riseholmeDatum()};
+  GnssFix fixAt(double t, const Eigen::Vector2d& p, double var = 1.0, int cov_type = 2) const {
+    GnssFix f;
+    f.stamp = t;
+    const Eigen::Vector2d ll = datum.toLatLon(p);
+    f.latitude = ll.x();
+    f.longitude = ll.y();
+    f.altitude = 0.0;
+    f.status = 0;
+    f.covariance = {var, 0, 0, 0, var, 0, 0, 0, 4 * var};
+    f.covariance_type = cov_type;
+    return f;
+  }
+};
+}  // namespace
+
+TEST(GnssIngest, LikelihoodFromFixCovarianceDefaultSigmaAndFloor) {
+  GnssFixture fx;
+  GnssIngest gnss("picker_1", fx.map, fx.datum);
+  GnssResult r = gnss.process(fx.fixAt(1.0, {5.0, 0.0}, 1.0));  // sigma 1 m
+  ASSERT_TRUE(r.accepted()) << r.reason;
+  const core::Observation& o = *r.observation;
+  EXPECT_TRUE(o.identifying);
+  EXPECT_EQ(o.picker_id, "picker_1");
+  EXPECT_EQ(o.sensor, "gnss");
+  EXPECT_EQ(core::validateObservation(o, *fx.map), "");
+  EXPECT_NEAR(likelihoodAt(o, nodeAt(*fx.map, 5, 0)), 1.0, 1e-6);
+  EXPECT_NEAR(likelihoodAt(o, nodeAt(*fx.map, 6, 0)), std::exp(-0.5), 1e-5);
+  EXPECT_NEAR(likelihoodAt(o, nodeAt(*fx.map, 6, 1)), std::exp(-1.0), 1e-5);
+  EXPECT_EQ(likelihoodAt(o, nodeAt(*fx.map, 9, 0)), 0.0);  // beyond 3 sigma
+  EXPECT_FALSE(o.velocity.has_value());
+  // UNKNOWN covariance: default sigma 3 m -> node 3 m away has exp(-0.5).
+  r = gnss.process(fx.fixAt(2.0, {5.0, 0.0}, 0.0, 0));
+  ASSERT_TRUE(r.accepted()) << r.reason;
+  EXPECT_NEAR(likelihoodAt(*r.observation, nodeAt(*fx.map, 8, 0)), std::exp(-0.5), 1e-5);
+  // Tiny covariance is floored at min_sigma = 1 m.
+  r = gnss.process(fx.fixAt(3.0, {5.0, 0.0}, 1e-4));
+  ASSERT_TRUE(r.accepted()) << r.reason;
+  EXPECT_NEAR(likelihoodAt(*r.observation, nodeAt(*fx.map, 6, 0)), std::exp(-0.5), 1e-5);
+}
+
+TEST(GnssIngest, RejectsBadFixesAndKeepsGoing) {
+  GnssFixture fx;
+  GnssIngest gnss("picker_1", fx.map, fx.datum);
+  ASSERT_TRUE(gnss.process(fx.fixAt(10.0, {0.0, 0.0})).accepted());
+  GnssFix f = fx.fixAt(11.0, {0.5, 0.0});
+  f.status = -1;
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNoFix);
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.latitude = kNaN;
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNotFinite);
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.longitude = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNotFinite);
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.covariance[4] = -1.0;
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNegativeCovariance);
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.covariance_type = 3;
+  f.covariance[1] = f.covariance[3] = 5.0;  // |cov| > sqrt(var_x var_y): not PSD
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNegativeCovariance);
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.covariance[0] = kNaN;
+  EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNotFinite);
+  EXPECT_EQ(gnss.process(fx.fixAt(10.0, {0.5, 0.0})).rejection, GnssRejection::kOutOfOrder);  // repeated
+  EXPECT_EQ(gnss.process(fx.fixAt(9.0, {0.5, 0.0})).rejection, GnssRejection::kOutOfOrder);   // backwards
+  // NaN altitude is legal in NavSatFix: accepted.
+  f = fx.fixAt(11.0, {0.5, 0.0});
+  f.altitude = kNaN;
+  GnssResult ok = gnss.process(f);
+  EXPECT_TRUE(ok.accepted()) << ok.reason;
+  EXPECT_NEAR(ok.position.x(), 0.5, 1e-3);
+  const GnssCounters& c = gnss.counters();
+  EXPECT_EQ(c.accepted, 2u);
+  EXPECT_EQ(c.no_fix, 1u);
+  EXPECT_EQ(c.not_finite, 3u);
+  EXPECT_EQ(c.negative_covariance, 2u);
+  EXPECT_EQ(c.out_of_order, 2u);
+}
+
+TEST(GnssIngest, ImpossibleJumpGateAndReanchoring) {
+  GnssFixture fx;
+  GnssIngest gnss("picker_1", fx.map, fx.datum);  // max_speed 3 m/s, gate 5 sigma, reset after 5
+  ASSERT_TRUE(gnss.process(fx.fixAt(1.0, {0.0, 0.0})).accepted());
+  // 3 m in 1 s: C = 1 + 1 + 9 = 11 m^2 -> Mahalanobis 0.9: accepted.
+  ASSERT_TRUE(gnss.process(fx.fixAt(2.0, {3.0, 0.0})).accepted());
+  // 15 m in 1 s: C = 11 -> 15 / 3.32 = 4.5 < 5: still accepted (a fast but possible move + noise).
+  ASSERT_TRUE(gnss.process(fx.fixAt(3.0, {18.0, 0.0})).accepted());
+  // 30 m back in 0.5 s: C = 2 + 2.25 -> 30 / 2.06 = 14.6 > 5: rejected.
+  GnssResult r = gnss.process(fx.fixAt(3.5, {-12.0, 0.0}));
+  EXPECT_EQ(r.rejection, GnssRejection::kImpossibleJump);
+  // Four more there -> the fifth consecutive rejection re-anchors (accepted).
+  EXPECT_EQ(gnss.process(fx.fixAt(3.6, {-12.0, 0.0})).rejection, GnssRejection::kImpossibleJump);
+  EXPECT_EQ(gnss.process(fx.fixAt(3.7, {-12.0, 0.0})).rejection, GnssRejection::kImpossibleJump);
+  EXPECT_EQ(gnss.process(fx.fixAt(3.8, {-12.0, 0.0})).rejection, GnssRejection::kImpossibleJump);
+  r = gnss.process(fx.fixAt(3.9, {-12.0, 0.0}));
+  EXPECT_TRUE(r.accepted());
+  EXPECT_EQ(gnss.counters().impossible_jump, 4u);
+  EXPECT_EQ(gnss.counters().gate_resets, 1u);
+  EXPECT_FALSE(r.observation->velocity.has_value());  // window restarted
+}
+
+TEST(GnssIngest, VelocityOverTheLastTenFixesAndBlackouts) {
+  GnssFixture fx;
+  GnssIngest gnss("picker_1", fx.map, fx.datum);
+  double t = 0.0;
+  Eigen::Vector2d p(-15.0, 0.0);
+  for (int i = 0; i < 5; ++i, t += 1.0, p.x() += 2.0) ASSERT_TRUE(gnss.process(fx.fixAt(t, p)).accepted());
+  GnssResult r;
+  for (int i = 0; i < 10; ++i, t += 1.0, p += Eigen::Vector2d(1.0, 0.5)) r = gnss.process(fx.fixAt(t, p));
+  ASSERT_TRUE(r.accepted());
+  ASSERT_TRUE(r.observation->velocity.has_value());
+  // The last 10 fixes all moved (1, 0.5) m per s.
+  EXPECT_NEAR(r.observation->velocity->x(), 1.0, 1e-6);
+  EXPECT_NEAR(r.observation->velocity->y(), 0.5, 1e-6);
+  const double last = t - 1.0;
+  EXPECT_FALSE(gnss.inBlackout(last + 5.0));
+  EXPECT_TRUE(gnss.inBlackout(last + 10.5));
+  // A fix 30 s later ends a blackout: reported, no velocity across the gap, gate skipped (far away is fine).
+  r = gnss.process(fx.fixAt(last + 30.0, p + Eigen::Vector2d(10.0, 0.0)));
+  ASSERT_TRUE(r.accepted()) << r.reason;
+  EXPECT_NEAR(r.blackout_ended, 30.0, 1e-9);
+  EXPECT_FALSE(r.observation->velocity.has_value());
+  EXPECT_EQ(gnss.counters().blackouts, 1u);
+  EXPECT_NEAR(gnss.counters().longest_blackout, 30.0, 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// RFID
+
+TEST(RfidObservationModel, ReadRegionLikelihoodAndBadInput) {
+  auto map = latticeMap(10.0, 1.0);
+  RfidModelOptions o;
+  o.read_range = 2.0;
+  o.negative_information = false;
+  RfidObservationModel rfid(twoPickers(), map, o);
+  RfidRead read;
+  read.stamp = 1.0;
+  read.robot_id = "robot_1";
+  read.antenna_id = "robot_1/rfid_antenna";
+  read.tag_id = "rfid_2";
+  read.antenna_pose = Eigen::Vector3d(0.0, 0.0, 0.0);
+  RfidResult r = rfid.process(read);
+  ASSERT_TRUE(r.accepted());
+  const core::Observation& obs = *r.observation;
+  EXPECT_EQ(obs.picker_id, "picker_2");
+  EXPECT_TRUE(obs.identifying);
+  EXPECT_EQ(obs.robot_id, "robot_1");
+  // Lattice points within 2 m of the origin: 13 (x^2 + y^2 <= 4).
+  EXPECT_EQ(obs.nodes.size(), 13u);
+  for (std::size_t i = 0; i < obs.nodes.size(); ++i) {
+    EXPECT_LE(map->position2d(obs.nodes[i]).norm(), 2.0 + 1e-9);
+    EXPECT_EQ(obs.likelihood[i], 1.0);
+  }
+  EXPECT_EQ(core::validateObservation(obs, *map), "");
+  // Directional antenna facing +y with a 45 deg half beam: (0,0), (0,1), (0,2), (1,1), (-1,1) -> 5 nodes.
+  RfidModelOptions od = o;
+  od.beam_half_angle = M_PI / 4.0 + 1e-9;
+  RfidObservationModel beam(twoPickers(), map, od);
+  EXPECT_EQ(beam.nodesInReadRegion(Eigen::Vector3d(0.0, 0.0, M_PI / 2.0)).size(), 5u);
+  // Bad input.
+  RfidRead bad = read;
+  bad.tag_id = "stranger";
+  EXPECT_EQ(rfid.process(bad).rejection, RfidRejection::kUnknownTag);
+  bad = read;
+  bad.antenna_pose.x() = kNaN;
+  EXPECT_EQ(rfid.process(bad).rejection, RfidRejection::kNotFinite);
+  bad = read;
+  bad.stamp = 0.5;
+  EXPECT_EQ(rfid.process(bad).rejection, RfidRejection::kOutOfOrder);
+  // Far from every node: the nearest node carries the read.
+  read.stamp = 2.0;
+  read.antenna_pose = Eigen::Vector3d(50.0, 0.0, 0.0);
+  r = rfid.process(read);
+  ASSERT_TRUE(r.accepted());
+  ASSERT_EQ(r.observation->nodes.size(), 1u);
+  EXPECT_EQ(r.observation->nodes[0], nodeAt(*map, 10.0, 0.0));
+  EXPECT_EQ(rfid.counters().accepted, 2u);
+  EXPECT_EQ(rfid.counters().unknown_tag, 1u);
+}
+
+TEST(RfidObservationModel, NegativeInformationForPickersNotRead) {
+  auto map = latticeMap(10.0, 1.0);
+  RfidModelOptions o;
+  o.read_range = 2.0;
+  o.negative_window = 5.0;
+  o.negative_period = 5.0;
+  o.p_detect = 0.7;
+  RfidObservationModel rfid(twoPickers(), map, o);
+  RfidRead read;
+  read.antenna_id = "a";
+  read.tag_id = "rfid_1";
+  std::vector<double> negative_stamps;
+  for (int i = 0; i <= 12; ++i) {
+    read.stamp = i;
+    RfidResult r = rfid.process(read);
+    ASSERT_TRUE(r.accepted());
+    for (const core::Observation& n : r.negative) {
+      EXPECT_EQ(n.picker_id, "picker_2");
+      EXPECT_TRUE(n.identifying);
+      ASSERT_EQ(n.nodes.size(), map->numNodes());  // every node listed: unlisted would mean 0
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 0, 0)), 0.3, 1e-12);
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 2, 0)), 0.3, 1e-12);
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 3, 0)), 1.0, 1e-12);
+      EXPECT_EQ(core::validateObservation(n, *map), "");
+      negative_stamps.push_back(read.stamp);
+    }
+  }
+  // Reading since t = 0; the first negative after a full window (t = 5), then once per period.
+  EXPECT_EQ(negative_stamps, (std::vector<double>{5.0, 10.0}));
+  // picker_2 read at 13 -> no negative for it until its read is older than the window.
+  read.tag_id = "rfid_2";
+  read.stamp = 13.0;
+  EXPECT_TRUE(rfid.process(read).negative.empty());  // picker_1 was read at 12
+  read.tag_id = "rfid_1";
+  read.stamp = 16.0;
+  EXPECT_TRUE(rfid.process(read).negative.empty());  // picker_2 read 3 s ago
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Range Histogram Filter
+
+namespace {
+const std::vector<Eigen::Vector2d> kAnchors = {{1.0, 1.0}, {1.0, -1.0}, {-1.0, 0.0}};
+
+std::vector<RangeMeasurement> rangesTo(const Eigen::Vector2d& person_robot, double sigma = 0.05,
+                                       const std::vector<Eigen::Vector2d>& anchors = kAnchors) {
+  std::vector<RangeMeasurement> out;
+  for (const auto& a : anchors) out.push_back({a, (person_robot - a).norm(), sigma * sigma});
+  return out;
+}
+}  // namespace
+
+TEST(RangeHistogramFilter, NormaliseGridIsEq3) {
+  std::vector<float> g = {2.0f, 1.0f, 0.01f, 0.15f};
+  normaliseGrid(g, 0.05f, 0.1f);  // /2 -> 1, 0.5, 0.005 (< thr -> 0.1), 0.075 (> thr but < P_min -> 0.1)
+  EXPECT_FLOAT_EQ(g[0], 1.0f);
+  EXPECT_FLOAT_EQ(g[1], 0.5f);
+  EXPECT_FLOAT_EQ(g[2], 0.1f);
+  EXPECT_FLOAT_EQ(g[3], 0.1f);
+  std::vector<float> z = {0.0f, 0.0f};
+  normaliseGrid(z, 0.05f, 0.2f);
+  EXPECT_FLOAT_EQ(z[0], 0.2f);
+}
+
+TEST(RangeHistogramFilter, ThreeAnchorsLocateThePerson) {
+  RangeHistogramFilter rhf;
+  EXPECT_EQ(rhf.cellsX(), 400);
+  EXPECT_EQ(rhf.cellsY(), 400);
+  auto e = rhf.update(0.0, rangesTo({4.0, 1.5}));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->position.x(), 4.0, 0.1);
+  EXPECT_NEAR(e->position.y(), 1.5, 0.1);
+  EXPECT_LT(e->covariance.trace(), 0.3);
+  EXPECT_GT(e->support_cells, 0u);
+  // The grid is in [P_min^inov * P_min^obs, 1] with max exactly 1.
+  const auto& g = rhf.grid();
+  EXPECT_FLOAT_EQ(*std::max_element(g.begin(), g.end()), 1.0f);
+  EXPECT_GT(*std::min_element(g.begin(), g.end()), 0.0f);
+}
+
+TEST(RangeHistogramFilter, CameraBearingResolvesASingleRing) {
+  // One anchor at the robot centre: a ring of radius 5. Alone, the estimate is the ring's centre with a wide
+  // covariance; with a bearing of atan2(3, 4) it is the ring-ray intersection (4, 3).
+  const std::vector<Eigen::Vector2d> one = {{0.0, 0.0}};
+  RangeHistogramFilter ring;
+  auto e = ring.update(0.0, rangesTo({4.0, 3.0}, 0.05, one));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_LT(e->position.norm(), 0.5);
+  EXPECT_GT(e->covariance.trace(), 20.0);  // ring of radius 5: ~ 25 / 2 per axis
+  RangeHistogramFilter fused;
+  e = fused.update(0.0, rangesTo({4.0, 3.0}, 0.05, one), {{Eigen::Vector2d::Zero(), std::atan2(3.0, 4.0), 0.03}});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->position.x(), 4.0, 0.15);
+  EXPECT_NEAR(e->position.y(), 3.0, 0.15);
+}
+
+TEST(RangeHistogramFilter, InnovationDilatesByMaxSpeed) {
+  // Move 1.2 m in 1 s: reachable with U = 1.5 m/s (estimate follows), not with U = 0.5 m/s (the innovation
+  // floor P_min^inov = 0.01 < the observation floor 0.05 keeps the old place: hand-computed 0.01 vs 0.05).
+  for (double u : {1.5, 0.5}) {
+    RhfOptions o;
+    o.max_speed = u;
+    RangeHistogramFilter rhf(o);
+    ASSERT_TRUE(rhf.update(0.0, rangesTo({4.0, 0.0})).has_value());
+    auto e = rhf.update(1.0, rangesTo({4.0, 1.2}));
+    ASSERT_TRUE(e.has_value());
+    if (u > 1.2) {
+      EXPECT_NEAR(e->position.y(), 1.2, 0.1) << "U " << u;
+    } else {
+      EXPECT_NEAR(e->position.y(), 0.0, 0.1) << "U " << u;
+    }
+  }
+}
+
+TEST(RangeHistogramFilter, UnreachableJumpRecoversOnTheSecondUpdate) {
+  RangeHistogramFilter rhf;  // U = 1.5 m/s, P_min^obs 0.05, P_min^inov 0.01
+  ASSERT_TRUE(rhf.update(0.0, rangesTo({4.0, 0.0})).has_value());
+  ASSERT_TRUE(rhf.update(0.1, rangesTo({4.0, 0.0})).has_value());
+  // Jump to (-4, 3) in 0.1 s. Update 3: old place 0.05 * 1, new place 1 * 0.01 -> stays (old = 1, new = 0.2).
+  auto e = rhf.update(0.2, rangesTo({-4.0, 3.0}));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->position.x(), 4.0, 0.15);
+  // Update 4: old 0.05 * 1, new 1 * 0.2 -> moves (new = 1, old = 0.25).
+  e = rhf.update(0.3, rangesTo({-4.0, 3.0}));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_NEAR(e->position.x(), -4.0, 0.15);
+  EXPECT_NEAR(e->position.y(), 3.0, 0.15);
+}
+
+TEST(RangeHistogramFilter, MovingAndTurningRobotKeepsAStaticPersonInTheFixedFrame) {
+  RangeHistogramFilter rhf;
+  const Eigen::Vector2d person(2.0, 4.0);  // fixed frame
+  for (int i = 0; i < 20; ++i) {
+    Eigen::Isometry2d pose = Eigen::Isometry2d::Identity();
+    pose.translation() = Eigen::Vector2d(0.13 * i, -0.07 * i);
+    pose.linear() = Eigen::Rotation2Dd(0.05 * i).toRotationMatrix();
+    const Eigen::Vector2d in_robot = pose.inverse() * person;
+    auto e = rhf.update(0.1 * i, rangesTo(in_robot), {}, pose);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_NEAR((e->position - person).norm(), 0.0, 0.12) << "step " << i;
+  }
+}
+
+TEST(RangeHistogramFilter, BadInputLeavesTheFilterUnchanged) {
+  RangeHistogramFilter rhf;
+  EXPECT_FALSE(rhf.update(0.0, {}).has_value());
+  EXPECT_FALSE(rhf.initialised());
+  EXPECT_FALSE(rhf.update(0.0, {{Eigen::Vector2d::Zero(), kNaN, 0.01}, {Eigen::Vector2d::Zero(), -1.0, 0.01}}).has_value());
+  ASSERT_TRUE(rhf.update(1.0, rangesTo({4.0, 1.5})).has_value());
+  const std::vector<float> before = rhf.grid();
+  EXPECT_FALSE(rhf.update(0.5, rangesTo({-4.0, 1.5})).has_value());  // backwards
+  EXPECT_EQ(rhf.grid(), before);
+  RhfOptions bad;
+  bad.p_min_uwb = 0.0;
+  EXPECT_THROW(RangeHistogramFilter{bad}, std::invalid_argument);
+  bad = RhfOptions();
+  bad.resolution = -1.0;
+  EXPECT_THROW(RangeHistogramFilter{bad}, std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// Seed 002 PDoA and UwbRanging
+
+TEST(Pdoa, RelativePositionFromRangeAndPathDifference) {
+  // Tag at (3, 4), antennas at (0, 0) and (1, 0): r = 5, r2 = sqrt(20), p = 5 - sqrt(20).
+  const double r = 5.0, r2 = std::sqrt(20.0);
+  auto p = relativePositionFromPathDifference(r, r - r2, 1.0);
+  ASSERT_TRUE(p.has_value());
+  EXPECT_NEAR(p->x(), 3.0, 1e-12);
+  EXPECT_NEAR(p->y(), 4.0, 1e-12);
+  EXPECT_NEAR(relativePositionFromPathDifference(r, r - r2, 1.0, false)->y(), -4.0, 1e-12);
+  EXPECT_FALSE(relativePositionFromPathDifference(r, 1.5, 1.0).has_value());  // |p| > d
+  EXPECT_FALSE(relativePositionFromPathDifference(kNaN, 0.1, 1.0).has_value());
+  // Seed 002: d = lambda / 2 at 6.5 GHz (~0.023 m); a phase difference of pi is a path difference of d.
+  const double lambda = 299792458.0 / 6.5e9;
+  EXPECT_NEAR(pathDifferenceFromPhase(M_PI, lambda), lambda / 2.0, 1e-15);
+  const Eigen::Vector2d q = relativePositionFromAngle(2.0, M_PI / 2.0);
+  EXPECT_NEAR(q.x(), 0.0, 1e-12);
+  EXPECT_NEAR(q.y(), 2.0, 1e-12);
+  const Eigen::Matrix2d c = relativePositionCovariance(2.0, 0.0, 0.01, 0.1);  // radial 0.01, tangential 0.04
+  EXPECT_NEAR(c(0, 0), 0.01, 1e-12);
+  EXPECT_NEAR(c(1, 1), 0.04, 1e-12);
+}
+
+namespace {
+UwbRangeInput uwbInput(double t, const std::string& tag, int anchor, double range) {
+  UwbRangeInput in;
+  in.stamp = t;
+  in.robot_id = "robot_1";
+  in.tag_id = tag;
+  in.anchor_id = "robot_1/uwb_anchor_" + std::to_string(anchor);
+  in.anchor_in_robot = Eigen::Isometry2d::Identity();
+  in.anchor_in_robot.translation() = kAnchors[static_cast<std::size_t>(anchor)];
+  in.range = range;
+  in.variance = 0.0025;
+  return in;
+}
+}  // namespace
+
+TEST(UwbRanging, BatchesAnchorsIntoOneObservationAndRejectsBadInput) {
+  auto map = latticeMap(10.0, 0.5);
+  UwbRanging uwb(twoPickers(), map);
+  Eigen::Isometry2d robot = Eigen::Isometry2d::Identity();
+  robot.translation() = Eigen::Vector2d(-2.0, 1.0);
+  const Eigen::Vector2d person_map(2.0, 2.5), person_robot = person_map - robot.translation();
+  std::vector<core::Observation> out;
+  for (int a = 0; a < 3; ++a)
+    EXPECT_EQ(uwb.addRange(uwbInput(1.0 + 0.01 * a, "uwb_2", a, (person_robot - kAnchors[a]).norm()), robot, &out),
+              UwbRejection::kNone);
+  EXPECT_TRUE(out.empty());  // batch still open
+  uwb.flush(1.05, &out);
+  EXPECT_TRUE(out.empty());  // window 0.1 s not over
+  uwb.flush(1.2, &out);
+  ASSERT_EQ(out.size(), 1u);
+  const core::Observation& o = out[0];
+  EXPECT_EQ(o.picker_id, "picker_2");
+  EXPECT_EQ(o.sensor, "uwb");
+  EXPECT_EQ(o.robot_id, "robot_1");
+  EXPECT_TRUE(o.identifying);
+  EXPECT_NEAR(o.stamp, 1.02, 1e-12);
+  ASSERT_TRUE(o.position.has_value());
+  EXPECT_NEAR((*o.position - person_map).norm(), 0.0, 0.1);
+  EXPECT_EQ(core::validateObservation(o, *map), "");
+  EXPECT_NEAR(likelihoodAt(o, nodeAt(*map, 2.0, 2.5)), 1.0, 0.05);
+  // Bad input, then good input still works.
+  std::string why;
+  EXPECT_EQ(uwb.addRange(uwbInput(2.0, "nobody", 0, 3.0), robot, &out, &why), UwbRejection::kUnknownTag);
+  EXPECT_NE(why.find("nobody"), std::string::npos);
+  EXPECT_EQ(uwb.addRange(uwbInput(2.0, "uwb_2", 0, kNaN), robot, &out), UwbRejection::kNotFinite);
+  EXPECT_EQ(uwb.addRange(uwbInput(2.0, "uwb_2", 0, -0.5), robot, &out), UwbRejection::kNegativeRange);
+  EXPECT_EQ(uwb.addRange(uwbInput(2.0, "uwb_2", 0, 40.0), robot, &out), UwbRejection::kOutOfRange);
+  EXPECT_EQ(uwb.addRange(uwbInput(0.5, "uwb_2", 0, 3.0), robot, &out), UwbRejection::kOutOfOrder);
+  Eigen::Isometry2d nan_pose = robot;
+  nan_pose.translation().x() = kNaN;
+  EXPECT_EQ(uwb.addRange(uwbInput(2.0, "uwb_2", 0, 3.0), nan_pose, &out), UwbRejection::kNotFinite);
+  for (int a = 0; a < 3; ++a)
+    EXPECT_EQ(uwb.addRange(uwbInput(2.0, "uwb_2", a, (person_robot - kAnchors[a]).norm()), robot, &out),
+              UwbRejection::kNone);
+  // The same anchor again closes the batch at once.
+  EXPECT_EQ(uwb.addRange(uwbInput(2.05, "uwb_2", 0, (person_robot - kAnchors[0]).norm()), robot, &out),
+            UwbRejection::kNone);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR((*out[1].position - person_map).norm(), 0.0, 0.1);
+  const UwbCounters& c = uwb.counters();
+  EXPECT_EQ(c.unknown_tag, 1u);
+  EXPECT_EQ(c.not_finite, 2u);
+  EXPECT_EQ(c.negative_range, 1u);
+  EXPECT_EQ(c.out_of_range, 1u);
+  EXPECT_EQ(c.out_of_order, 1u);
+  EXPECT_EQ(c.updates, 2u);
+}
+
+TEST(UwbRanging, PdoaDirectAndAsBearing) {
+  auto map = latticeMap(10.0, 0.5);
+  UwbRangingOptions o;
+  o.pdoa_mode = "direct";
+  UwbRanging direct(twoPickers(), map, o);
+  Eigen::Isometry2d robot = Eigen::Isometry2d::Identity();
+  robot.linear() = Eigen::Rotation2Dd(M_PI / 2.0).toRotationMatrix();  // robot faces +y
+  UwbRangeInput in = uwbInput(1.0, "uwb_1", 0, 4.0);                  // anchor at (1, 1) in base_link
+  in.pdoa_angle = 0.0;                                                // straight ahead of the anchor
+  std::vector<core::Observation> out;
+  ASSERT_EQ(direct.addRange(in, robot, &out), UwbRejection::kNone);
+  ASSERT_EQ(out.size(), 1u);
+  // base_link (1 + 4, 1) = (5, 1) -> map (-1, 5).
+  EXPECT_NEAR(out[0].position->x(), -1.0, 1e-9);
+  EXPECT_NEAR(out[0].position->y(), 5.0, 1e-9);
+  // Radial (map y) variance 0.0025 -> floored by min_sigma 0.3 in the likelihood; tangential (4 * 0.17)^2.
+  EXPECT_NEAR(out[0].position_covariance(0, 0), 16.0 * 0.17 * 0.17, 1e-9);
+  // As a bearing in the RHF: a single anchor ring + the PDoA angle -> the same point.
+  o.pdoa_mode = "bearing";
+  UwbRanging bearing(twoPickers(), map, o);
+  out.clear();
+  ASSERT_EQ(bearing.addRange(in, robot, &out), UwbRejection::kNone);
+  bearing.flush(2.0, &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0].position->x(), -1.0, 0.3);
+  EXPECT_NEAR(out[0].position->y(), 5.0, 0.3);
+}
