@@ -13,11 +13,11 @@ namespace picker_localisation {
 namespace sensors {
 
 struct LegClassifierTrainingOptions {
-  int num_trees = 80;          // forest size
-  int max_depth = 12;          // per tree
+  int num_trees = 50;          // forest size
+  int max_depth = 10;          // per tree
   int min_sample_count = 4;    // a node with fewer samples is not split
   int active_vars = 0;         // features tried per split (0: sqrt(count))
-  bool balance_classes = true; // weight positives and negatives equally (priors)
+  double positive_prior = 8.0;  // prior weight of the leg class relative to non-legs (<= 0: balance the classes)
   int seed = 1;                // cv::RNG seed used while training (OpenCV's global RNG is re-seeded)
 };
 

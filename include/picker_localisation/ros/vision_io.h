@@ -1,0 +1,32 @@
+// ROS message / bag adapters of the sensors_vision area: LaserScan -> LaserScanData, and the labelled leg bags
+// of ../shared/data/leg_tracker (rosbag C++ API, no master needed).
+#pragma once
+
+#include <sensor_msgs/LaserScan.h>
+
+#include <string>
+#include <vector>
+
+#include "picker_localisation/sensors_vision/leg_training.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+sensors::LaserScanData toScanData(const sensor_msgs::LaserScan& msg);
+
+struct BagScan {
+  std::string topic;
+  std::string frame_id;
+  sensors::LaserScanData scan;
+};
+
+// Every sensor_msgs/LaserScan in the bag, in recording order; `topics` empty: all LaserScan topics.
+// Throws rosbag::BagException when the file cannot be opened.
+std::vector<BagScan> readBagScans(const std::string& bag_path, const std::vector<std::string>& topics = {});
+
+// A leg_tracker "positive_N_extracted" bag: the k-th /leg_cluster_positions PoseArray labels the k-th
+// /training_scan (both are written as one pair per scan by the extraction tool).
+std::vector<sensors::LabelledScan> readLabelledLegBag(const std::string& bag_path);
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

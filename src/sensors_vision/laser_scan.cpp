@@ -1,0 +1,62 @@
+#include "picker_localisation/sensors_vision/laser_scan.h"
+
+#include <cmath>
+
+namespace picker_localisation {
+namespace sensors {
+
+bool LaserScanData::validRange(std::size_t i) const {
+  if (i >= ranges.size()) return false;
+  const double r = ranges[i];
+  return std::isfinite(r) && r >= range_min && r <= range_max && r > 0.0;
+}
+
+std::size_t LaserScanData::validCount() const {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < ranges.size(); ++i) n += validRange(i) ? 1 : 0;
+  return n;
+}
+
+Eigen::Vector2d ScanCluster::centroid() const {
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  if (points.empty()) return c;
+  for (const auto& p : points) c += p;
+  return c / static_cast<double>(points.size());
+}
+
+std::vector<ScanCluster> segmentScan(const LaserScanData& scan, const SegmentationOptions& options) {
+  std::vector<ScanCluster> out;
+  if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment)) return out;
+  ScanCluster current;
+  auto close = [&]() {
+    // Algorithm 3 line 6: keep the object only when dim(c_j) > m_c (here >= min_points, <= max_points).
+    if (current.points.size() >= options.min_points && current.points.size() <= options.max_points)
+      out.push_back(std::move(current));
+    current = ScanCluster();
+  };
+  bool have_previous = false;
+  Eigen::Vector2d previous;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    if (!scan.validRange(i)) {
+      if (options.break_on_invalid && !current.points.empty()) {
+        close();
+        have_previous = false;
+      }
+      continue;
+    }
+    const double r = scan.ranges[i];
+    const double a = scan.angle(i);
+    const Eigen::Vector2d p(r * std::cos(a), r * std::sin(a));
+    if (have_previous && (p - previous).norm() >= options.jump_distance) close();  // line 3 / line 9
+    if (current.points.empty()) current.first_beam = i;
+    current.points.push_back(p);
+    current.ranges.push_back(r);
+    previous = p;
+    have_previous = true;
+  }
+  if (!current.points.empty()) close();
+  return out;
+}
+
+}  // namespace sensors
+}  // namespace picker_localisation

@@ -1,0 +1,86 @@
+// Trains the leg classifier from the labelled leg_tracker bags and writes the OpenCV model file.
+//   train_leg_classifier --data DIR --out config/leg_classifier.yml [--sweep]
+// (--sweep prints held-out recall / precision / false legs per scan for thresholds 0.1..0.9)
+// DIR holds positive_{1..4}_extracted.bag and negative_2.bag. Split (fixed, see leg_training.h): positives 1-3
+// and the first two thirds of negative_2 train; positive_4 and the last third of negative_2 are held out and
+// evaluated here (and in test_leg_detector_data).
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include "picker_localisation/ros/vision_io.h"
+
+using namespace picker_localisation;
+
+// Background clusters of the positive recordings farther than this from every labelled leg are negatives, m.
+constexpr double kUnlabelledNegativeDistance = 0.5;
+
+int main(int argc, char** argv) {
+  std::string data, out;
+  double hit = 0.15;
+  bool sweep = false;
+  for (int i = 1; i < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--sweep")) {
+      sweep = true;
+      --i;
+    } else if (i + 1 < argc && !std::strcmp(argv[i], "--data")) data = argv[i + 1];
+    else if (i + 1 < argc && !std::strcmp(argv[i], "--out")) out = argv[i + 1];
+    else {
+      std::fprintf(stderr, "unknown option %s\n", argv[i]);
+      return 2;
+    }
+  }
+  if (data.empty() || out.empty()) {
+    std::fprintf(stderr, "usage: train_leg_classifier --data DIR --out FILE.yml [--sweep]\n");
+    return 2;
+  }
+  try {
+    std::vector<sensors::LabelledScan> train_pos, test_pos;
+    for (int n = 1; n <= 4; ++n) {
+      auto scans = ros_adapter::readLabelledLegBag(data + "/positive_" + std::to_string(n) + "_extracted.bag");
+      auto& dst = n <= 3 ? train_pos : test_pos;
+      dst.insert(dst.end(), scans.begin(), scans.end());
+    }
+    const auto neg = ros_adapter::readBagScans(data + "/negative_2.bag");
+    const std::size_t split = sensors::negativeTrainCount(neg.size());
+    std::vector<sensors::LaserScanData> train_neg, test_neg;
+    for (std::size_t i = 0; i < neg.size(); ++i) (i < split ? train_neg : test_neg).push_back(neg[i].scan);
+
+    sensors::LegDetectorOptions options;
+    std::vector<sensors::LegFeatures> samples;
+    std::vector<int> labels;
+    sensors::collectTrainingSamples(train_pos, train_neg, options, hit, kUnlabelledNegativeDistance, samples, labels);
+    std::size_t npos = 0;
+    for (int l : labels) npos += l;
+    std::printf("training: %zu positive and %zu negative clusters (%zu + %zu scans)\n", npos, labels.size() - npos,
+                train_pos.size(), train_neg.size());
+    auto classifier = std::make_shared<sensors::LegClassifier>();
+    sensors::LegClassifierTrainingOptions topt;
+    classifier->train(samples, labels, topt);
+    classifier->save(out);
+    std::printf("wrote %s\n", out.c_str());
+
+    sensors::LegDetector detector(classifier, options);
+    const auto e = sensors::evaluateLegs(detector, test_pos, hit);
+    const auto n = sensors::evaluateNegatives(detector, test_neg);
+    std::printf("held out positive_4: %zu scans, %zu labels, %zu detections, recall %.3f, precision %.3f\n", e.scans,
+                e.labels, e.detections, e.recall(), e.precision());
+    std::printf("held out negative_2 (last third): %zu scans, %.3f false legs per scan\n", n.scans,
+                n.detectionsPerScan());
+    if (sweep)
+      for (double th = 0.1; th < 0.95; th += 0.1) {
+        auto o = options;
+        o.leg_threshold = th;
+        sensors::LegDetector d(classifier, o);
+        const auto a = sensors::evaluateLegs(d, test_pos, hit);
+        const auto b = sensors::evaluateNegatives(d, test_neg);
+        std::printf("  threshold %.1f: recall %.3f precision %.3f false/scan %.3f\n", th, a.recall(), a.precision(),
+                    b.detectionsPerScan());
+      }
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "train_leg_classifier: %s\n", ex.what());
+    return 1;
+  }
+  return 0;
+}

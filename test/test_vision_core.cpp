@@ -1,0 +1,231 @@
+// sensors_vision core: Munkres vs brute force, bearing vs hand-computed values, Algorithm 3 segmentation on a
+// hand-built scan, the cluster tracker's id stability / hysteresis, the fusion cone. No roscore.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "picker_localisation/sensors_vision/cluster_tracker.h"
+#include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
+#include "picker_localisation/sensors_vision/munkres.h"
+#include "picker_localisation/sensors_vision/person_box_detector.h"
+
+using namespace picker_localisation::sensors;
+
+namespace {
+
+// Minimum over all injective maps of the smaller side into the larger (permutations).
+double bruteForce(const Eigen::MatrixXd& c) {
+  const bool t = c.rows() > c.cols();
+  const Eigen::MatrixXd m = t ? Eigen::MatrixXd(c.transpose()) : c;
+  std::vector<int> cols(m.cols());
+  std::iota(cols.begin(), cols.end(), 0);
+  double best = 1e18;
+  do {
+    double s = 0;
+    for (int r = 0; r < m.rows(); ++r) s += m(r, cols[r]);
+    best = std::min(best, s);
+  } while (std::next_permutation(cols.begin(), cols.end()));
+  return best;
+}
+
+}  // namespace
+
+TEST(Munkres, MatchesBruteForceOnRandomRectangularMatrices) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> u(0.0, 10.0);
+  std::uniform_int_distribution<int> size(1, 6);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = size(rng), m = size(rng);
+    Eigen::MatrixXd c(n, m);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < m; ++j) c(i, j) = trial % 3 == 0 ? std::floor(u(rng)) : u(rng);  // ties too
+    const auto a = solveAssignment(c);
+    ASSERT_EQ(static_cast<int>(a.size()), n);
+    int assigned = 0;
+    std::vector<int> seen;
+    for (int col : a)
+      if (col >= 0) {
+        ++assigned;
+        seen.push_back(col);
+      }
+    std::sort(seen.begin(), seen.end());
+    EXPECT_TRUE(std::adjacent_find(seen.begin(), seen.end()) == seen.end()) << "column used twice";
+    EXPECT_EQ(assigned, std::min(n, m));
+    EXPECT_NEAR(assignmentCost(c, a), bruteForce(c), 1e-9) << "trial " << trial;
+  }
+}
+
+TEST(Munkres, HandExampleAndEmpty) {
+  Eigen::MatrixXd c(3, 3);
+  c << 4, 1, 3, 2, 0, 5, 3, 2, 2;  // optimum 1 + 2 + 2 = 5: (0,1) (1,0) (2,2)
+  EXPECT_EQ(solveAssignment(c), (std::vector<int>{1, 0, 2}));
+  EXPECT_TRUE(solveAssignment(Eigen::MatrixXd(0, 3)).empty());
+  EXPECT_EQ(solveAssignment(Eigen::MatrixXd(2, 0)), (std::vector<int>{-1, -1}));
+}
+
+TEST(Bearing, HandComputedValues) {
+  CameraIntrinsics k{500.0, 320.0, 640};
+  // Column 320 is the principal point: straight ahead.
+  EXPECT_NEAR(bearingFromColumn(320.0, k), 0.0, 1e-12);
+  // Column 820 - 500 px = 320 - 500 = -180... use u = 820? Outside; u = 0: atan(320 / 500) = 0.5693 rad (left).
+  EXPECT_NEAR(bearingFromColumn(0.0, k), 0.569313191, 1e-6);
+  // u = 820 would be right; u = 570: atan(-250 / 500) = -0.463647609 rad (right of centre).
+  EXPECT_NEAR(bearingFromColumn(570.0, k), -0.463647609, 1e-6);
+  // Box centre column = 100 + 240 / 2 = 220: atan(100 / 500) = 0.197395560.
+  EXPECT_NEAR(bearingFromBox(cv::Rect(100, 50, 240, 300), k), 0.197395560, 1e-6);
+  // Eq. 1 with the field of view: 90 deg fov, 640 px, u = 0 -> atan(2 * 320 * 1 / 640) = pi / 4.
+  EXPECT_NEAR(bearingFromColumnFov(0.0, M_PI / 2, 640), M_PI / 4, 1e-12);
+  // Both forms agree when fx = (w / 2) / tan(fov / 2) and cx = w / 2.
+  const double fov = 1.2;
+  CameraIntrinsics k2{320.0 / std::tan(0.6), 320.0, 640};
+  for (double u : {0.0, 100.0, 333.0, 639.0}) EXPECT_NEAR(bearingFromColumn(u, k2), bearingFromColumnFov(u, fov, 640), 1e-12);
+  EXPECT_THROW(bearingFromColumn(1.0, CameraIntrinsics{0.0, 1.0, 2}), std::invalid_argument);
+}
+
+namespace {
+
+// A scan with beams 1 degree apart; `objects` are (first beam, last beam, range) blocks, the rest no return.
+LaserScanData blockScan(const std::vector<std::tuple<int, int, float>>& objects, int beams = 180) {
+  LaserScanData s;
+  s.angle_min = -M_PI / 2;
+  s.angle_increment = M_PI / 180.0;
+  s.range_min = 0.05;
+  s.range_max = 10.0;
+  s.ranges.assign(beams, std::numeric_limits<float>::infinity());
+  for (const auto& [a, b, r] : objects)
+    for (int i = a; i <= b; ++i) s.ranges[i] = r;
+  return s;
+}
+
+}  // namespace
+
+TEST(Segmentation, JumpDistanceSplitsAndRichnessFilters) {
+  // Beams 1 deg apart at 2 m are 0.035 m apart. Block A: beams 10-14 at 2 m; block B: 15-20 at 2.5 m (jump 0.5 m
+  // > d_c); block C: 40-41 (2 points < m_c = 3, dropped); block D: 60-70 at 3 m.
+  const auto scan = blockScan({{10, 14, 2.0f}, {15, 20, 2.5f}, {40, 41, 2.0f}, {60, 70, 3.0f}});
+  const auto clusters = segmentScan(scan);
+  ASSERT_EQ(clusters.size(), 3u);
+  EXPECT_EQ(clusters[0].points.size(), 5u);
+  EXPECT_EQ(clusters[0].first_beam, 10u);
+  EXPECT_EQ(clusters[1].points.size(), 6u);
+  EXPECT_EQ(clusters[2].points.size(), 11u);
+  // Centroid of block D: points on an arc at 3 m centred on beam 65 (angle -90 + 65 = -25 deg).
+  const Eigen::Vector2d c = clusters[2].centroid();
+  EXPECT_NEAR(std::atan2(c.y(), c.x()), -25.0 * M_PI / 180.0, 1e-9);
+  // NaN / inf / below range_min are no returns: an all-invalid scan has no clusters.
+  auto empty = blockScan({});
+  empty.ranges[5] = std::nanf("");
+  empty.ranges[6] = 0.01f;
+  EXPECT_TRUE(segmentScan(empty).empty());
+  LaserScanData zero;
+  EXPECT_TRUE(segmentScan(zero).empty());
+}
+
+TEST(LegPairing, NearestLegsPairedSingleLegsKept) {
+  std::vector<Leg> legs(3);
+  legs[0].position = {2.0, 0.0};
+  legs[0].confidence = 0.8;
+  legs[1].position = {2.0, 0.3};
+  legs[1].confidence = 0.6;
+  legs[2].position = {5.0, 0.0};
+  legs[2].confidence = 0.9;
+  LegDetectorOptions o;
+  const auto people = pairLegs(legs, o);
+  ASSERT_EQ(people.size(), 2u);
+  EXPECT_NEAR(people[0].position.y(), 0.15, 1e-12);
+  EXPECT_NEAR(people[0].confidence, 0.7, 1e-12);
+  EXPECT_EQ(people[1].leg_b, -1);
+  EXPECT_NEAR(people[1].confidence, 0.45, 1e-12);
+  o.single_leg_people = false;
+  EXPECT_EQ(pairLegs(legs, o).size(), 1u);
+}
+
+TEST(ClusterTracker, StableIdsHysteresisAndGating) {
+  ClusterTrackerOptions o;
+  o.gate_distance = 0.5;
+  o.hits_to_confirm = 3;
+  o.misses_to_delete = 2;
+  ClusterTracker tracker(o);
+  // Two objects walking in parallel 1 m apart, 0.1 m per scan; their order in the detection list swaps.
+  int id_a = -1, id_b = -1;
+  for (int k = 0; k < 6; ++k) {
+    const Eigen::Vector2d a(0.1 * k, 0.0), b(0.1 * k, 1.0);
+    std::vector<Eigen::Vector2d> det = (k % 2) ? std::vector<Eigen::Vector2d>{b, a} : std::vector<Eigen::Vector2d>{a, b};
+    tracker.update(0.1 * k, det);
+    const auto confirmed = tracker.confirmedTracks();
+    if (k < 2) EXPECT_TRUE(confirmed.empty()) << "confirmed before T_a hits";
+    if (k >= 2) {
+      ASSERT_EQ(confirmed.size(), 2u);
+      for (const auto& t : confirmed) {
+        const bool is_a = std::abs(t.position.y()) < 0.5;
+        int& id = is_a ? id_a : id_b;
+        if (id < 0) id = t.id;
+        EXPECT_EQ(t.id, id) << "id changed at scan " << k;
+      }
+    }
+  }
+  EXPECT_NE(id_a, id_b);
+  EXPECT_NEAR(tracker.confirmedTracks()[0].velocity.x(), 1.0, 1e-6);  // 0.1 m per 0.1 s
+  // A detection beyond the gate starts a new tentative track instead of moving A.
+  tracker.update(0.6, {Eigen::Vector2d(0.5, 1.0), Eigen::Vector2d(2.0, 0.0)});
+  bool a_alive = false;
+  for (const auto& t : tracker.tracks()) a_alive = a_alive || (t.id == id_a && t.misses == 1 && t.position.x() < 0.6);
+  EXPECT_TRUE(a_alive);
+  // A misses a second scan: removed (T_o = 2); B keeps its id.
+  tracker.update(0.7, {Eigen::Vector2d(0.6, 1.0)});
+  for (const auto& t : tracker.tracks()) EXPECT_NE(t.id, id_a);
+  ASSERT_EQ(tracker.confirmedTracks().size(), 1u);
+  EXPECT_EQ(tracker.confirmedTracks()[0].id, id_b);
+  // Empty scans are fine; stamps going backwards do not corrupt velocity.
+  tracker.update(0.65, {Eigen::Vector2d(0.7, 1.0)});
+  EXPECT_TRUE(tracker.confirmedTracks()[0].velocity.allFinite());
+  tracker.update(0.8, {});
+  tracker.update(0.9, {});
+  EXPECT_TRUE(tracker.tracks().empty());
+}
+
+TEST(LidarCameraFusion, NearestClusterInConeIsPromoted) {
+  LidarCameraFusionOptions o;
+  o.cone_margin = 0.0;
+  o.promote_after = 2;
+  o.demote_after = 2;
+  LidarCameraFusion fusion(o);
+  std::vector<FusionCandidate> c(3);
+  c[0].position = {4.0, 0.0};  // bearing 0, far
+  c[0].track_id = 7;
+  c[0].confidence = 0.3;
+  c[1].position = {2.0, 0.05};  // bearing 0.025, near: the one picked
+  c[1].track_id = 8;
+  c[1].confidence = 0.3;
+  c[2].position = {2.0, 2.0};  // bearing 0.785, outside the cone
+  c[2].track_id = 9;
+  BearingCone cone{0.0, 0.1, 0.9};
+  EXPECT_EQ(fusion.nearestInCone(cone, c), 1);
+  EXPECT_EQ(fusion.nearestInCone(BearingCone{M_PI, 0.1, 0.9}, c), -1);  // behind the camera
+  auto f = fusion.fuse(c, {cone}, true);
+  EXPECT_TRUE(f[1].camera_confirmed);
+  EXPECT_FALSE(f[0].camera_confirmed);
+  EXPECT_GT(f[1].confidence, f[0].confidence);
+  EXPECT_FALSE(fusion.promoted(8));
+  fusion.fuse(c, {cone}, true);
+  EXPECT_TRUE(fusion.promoted(8));
+  // LiDAR-only frames keep the promotion; camera frames without a match demote after m_r = 2.
+  EXPECT_TRUE(fusion.fuse(c, {}, false)[1].camera_confirmed);
+  fusion.fuse(c, {}, true);
+  EXPECT_TRUE(fusion.promoted(8));
+  fusion.fuse(c, {}, true);
+  EXPECT_FALSE(fusion.promoted(8));
+}
+
+TEST(NonMaximumSuppression, KeepsBestOfOverlappingBoxes) {
+  std::vector<PersonBox> boxes{{cv::Rect(0, 0, 100, 200), 0.5}, {cv::Rect(10, 10, 100, 200), 0.9},
+                               {cv::Rect(300, 0, 100, 200), 0.4}};
+  const auto kept = suppressOverlaps(boxes, 0.4);
+  ASSERT_EQ(kept.size(), 2u);
+  EXPECT_DOUBLE_EQ(kept[0].confidence, 0.9);
+  EXPECT_EQ(kept[1].box.x, 300);
+}
