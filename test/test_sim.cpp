@@ -394,11 +394,14 @@ TEST(GnssModel, DatumFileKeys) {
   const std::string path = ::testing::TempDir() + "/datum_test.yaml";
   {
     std::ofstream f(path);
-    f << "datum:\n  latitude: 53.1\n  longitude: -0.6\n  altitude: 12.0\n  heading: 15.0\n";
+    f << "datum:\n  type: local_cartesian\n  latitude: 53.1\n  longitude: -0.6\n  altitude: 12.0\n  heading_deg: 15.0\n";
   }
   const MapDatum d = loadMapDatum(path);
   EXPECT_DOUBLE_EQ(d.latitude, 53.1);
   EXPECT_DOUBLE_EQ(d.heading_deg, 15.0);
+  // The shipped datum file (sensors_ranging) is readable.
+  const MapDatum shipped = loadMapDatum(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  EXPECT_NEAR(shipped.latitude, 53.268, 0.01);
   {
     std::ofstream f(path);
     f << "longitude: 1.0\n";

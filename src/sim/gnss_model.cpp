@@ -31,10 +31,14 @@ MapDatum loadMapDatum(const std::string& path) {
     }
     if (!std::isfinite(out)) throw std::runtime_error(path + ": key '" + key + "' is not finite");
   };
+  if (root["type"] && root["type"].as<std::string>() != "local_cartesian")
+    throw std::runtime_error(path + ": datum type '" + root["type"].as<std::string>() +
+                             "' is not supported by the simulator (use local_cartesian)");
   get("latitude", d.latitude, true);
   get("longitude", d.longitude, true);
   get("altitude", d.altitude, false);
-  get("heading", d.heading_deg, false);
+  get("heading", d.heading_deg, false);  // older spelling
+  get("heading_deg", d.heading_deg, false);
   if (std::abs(d.latitude) > 90.0 || std::abs(d.longitude) > 180.0)
     throw std::runtime_error(path + ": latitude/longitude out of range");
   return d;

@@ -81,7 +81,7 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
       {"datum", section({{"latitude", set(c.datum.latitude)},
                          {"longitude", set(c.datum.longitude)},
                          {"altitude", set(c.datum.altitude)},
-                         {"heading", set(c.datum.heading_deg)}},
+                         {"heading_deg", set(c.datum.heading_deg)}},
                         "datum")},
       {"robot_motion", section({{"speed", set(c.robot_motion.speed)},
                                 {"patrol", [&c](const YAML::Node& n) {

@@ -28,18 +28,19 @@
 namespace picker_localisation {
 namespace sim {
 
-// Where the map frame sits on the Earth. Same keys as config/datum.yaml:
-//   latitude, longitude (deg, WGS84, of the map origin), altitude (m), heading (deg: angle of the map x axis
-//   counter-clockwise from East; 0 means map x = East, map y = North).
+// Where the map frame sits on the Earth. Same keys and convention as config/datum.yaml (sensors_ranging
+// GeodeticDatum, type local_cartesian): latitude, longitude (deg, WGS84, of the map origin), altitude (m),
+// heading_deg (deg: yaw of the map x axis counter-clockwise from East; 0 means map x = East, map y = North).
 struct MapDatum {
-  double latitude = 53.2680;    // Riseholme campus, Lincoln (UK), approximately
-  double longitude = -0.5270;
+  double latitude = 53.268;     // Riseholme campus, Lincoln (UK), approximately (as config/datum.yaml)
+  double longitude = -0.524;
   double altitude = 0.0;
   double heading_deg = 0.0;
 };
 
-// Reads a datum file (`latitude`, `longitude`, `altitude`, `heading` keys, optionally under a top-level
-// `datum:` mapping). Throws std::runtime_error with one line naming the file and the key on a bad file.
+// Reads a datum file such as config/datum.yaml (`latitude`, `longitude`, `altitude`, `heading_deg` keys,
+// optionally under a top-level `datum:` mapping; `type` must be local_cartesian when present). Throws
+// std::runtime_error with one line naming the file and the key on a bad file.
 MapDatum loadMapDatum(const std::string& path);
 
 // Map metres <-> WGS84 through GeographicLib::LocalCartesian at the datum.
