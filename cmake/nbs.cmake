@@ -10,3 +10,16 @@ target_link_libraries(picker_localisation_nbs PUBLIC picker_localisation_tpf)
 install(TARGETS picker_localisation_nbs
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+# ROS adapter of the planner node.
+add_library(picker_localisation_nbs_ros
+  src/ros/what_if_belief_source.cpp
+  src/ros/nbs_planner_node.cpp)
+target_link_libraries(picker_localisation_nbs_ros PUBLIC picker_localisation_ros picker_localisation_nbs)
+add_dependencies(picker_localisation_nbs_ros ${PROJECT_NAME}_generate_messages_cpp)
+install(TARGETS picker_localisation_nbs_ros
+  ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+pl_add_node(nbs_planner src/nodes/nbs_planner_node.cpp)
+target_link_libraries(nbs_planner picker_localisation_nbs_ros)

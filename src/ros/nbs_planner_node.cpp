@@ -1,0 +1,379 @@
+#include "picker_localisation/ros/nbs_planner_node.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/what_if_belief_source.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+namespace {
+
+YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
+  XmlRpc::XmlRpcValue x = v;  // the accessors are non-const
+  switch (x.getType()) {
+    case XmlRpc::XmlRpcValue::TypeBoolean: return YAML::Node(static_cast<bool>(x));
+    case XmlRpc::XmlRpcValue::TypeInt: return YAML::Node(static_cast<int>(x));
+    case XmlRpc::XmlRpcValue::TypeDouble: return YAML::Node(static_cast<double>(x));
+    case XmlRpc::XmlRpcValue::TypeString: return YAML::Node(static_cast<std::string>(x));
+    case XmlRpc::XmlRpcValue::TypeArray: {
+      YAML::Node n(YAML::NodeType::Sequence);
+      for (int i = 0; i < x.size(); ++i) n.push_back(toYaml(x[i]));
+      return n;
+    }
+    case XmlRpc::XmlRpcValue::TypeStruct: {
+      YAML::Node n(YAML::NodeType::Map);
+      for (auto it = x.begin(); it != x.end(); ++it) n[it->first] = toYaml(it->second);
+      return n;
+    }
+    default: return YAML::Node();
+  }
+}
+
+std_msgs::ColorRGBA utilityColour(double u) {
+  // red (0) -> yellow (0.5) -> green (1)
+  std_msgs::ColorRGBA c;
+  u = std::clamp(u, 0.0, 1.0);
+  c.r = static_cast<float>(u < 0.5 ? 1.0 : 2.0 * (1.0 - u));
+  c.g = static_cast<float>(u < 0.5 ? 2.0 * u : 1.0);
+  c.b = 0.1f;
+  c.a = 0.8f;
+  return c;
+}
+
+}  // namespace
+
+nbs::PlannerConfig plannerConfigFromParams(const ros::NodeHandle& pnh) {
+  XmlRpc::XmlRpcValue all;
+  if (!ros::param::get(pnh.getNamespace(), all) || all.getType() != XmlRpc::XmlRpcValue::TypeStruct)
+    return nbs::PlannerConfig();
+  YAML::Node node = toYaml(all);
+  // Integer-valued doubles given as ints (e.g. horizon_m: 20) convert fine through YAML scalars.
+  return nbs::PlannerConfig::fromYaml(node);
+}
+
+NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
+    : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_) {
+  const std::string name = ros::this_node::getName();
+  std::string ns = ros::this_node::getNamespace();
+  while (!ns.empty() && ns.front() == '/') ns.erase(ns.begin());
+  pnh_.param<std::string>("robot_id", robot_id_, ns.empty() ? "robot_1" : ns);
+  pnh_.param<std::string>("map_frame", map_frame_, "map");
+  pnh_.param<std::string>("base_frame", base_frame_, robot_id_ + "/base_link");
+  pnh_.param("battery_level", battery_level_, 1.0);
+  pnh_.param("claim_timeout", claim_timeout_, 30.0);
+  pnh_.param("tf_timeout", tf_timeout_, 0.2);
+  pnh_.param("use_what_if", use_what_if_, true);
+  pnh_.param("what_if_seed", what_if_seed_, 1);
+  double period = 5.0;
+  pnh_.param("planning_period", period, 5.0);
+  std::string pickers_file;
+  pnh_.param<std::string>("pickers_file", pickers_file, "");
+  if (!(period > 0.0) || !(claim_timeout_ > 0.0) || !(battery_level_ >= 0.0 && battery_level_ <= 1.0)) {
+    ROS_FATAL("%s: planning_period and claim_timeout must be > 0 and battery_level in [0, 1]", name.c_str());
+    return;
+  }
+
+  nbs::PlannerConfig config;
+  try {
+    config = plannerConfigFromParams(pnh_);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", name.c_str(), e.what());
+    return;
+  }
+  core::PickerRegistry registry;
+  try {
+    if (pickers_file.empty()) throw std::runtime_error("~pickers_file is not set (config/pickers.yaml)");
+    registry = core::PickerRegistry::load(pickers_file);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", name.c_str(), e.what());
+    return;
+  }
+  map_ = obtainMap(nh_, pnh_);
+  if (!map_) return;
+  try {
+    planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, config);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", name.c_str(), e.what());
+    return;
+  }
+
+  // Inputs: the trackers' beliefs (never ground truth), the other robots' goals, the battery.
+  for (const core::PickerConfig& p : registry.pickers()) {
+    auto in = std::make_unique<PickerInput>();
+    in->id = p.id;
+    const std::size_t k = pickers_.size();
+    in->sub = nh_.subscribe<picker_localisation::PickerBelief>(
+        "/pickers/" + p.id + "/belief", 5, [this, k](const picker_localisation::PickerBelief::ConstPtr& m) {
+          beliefCallback(k, m);
+        });
+    if (use_what_if_ && config.policy == nbs::Policy::kNextBestSense)
+      in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + p.id + "/what_if", true);
+    pickers_.push_back(std::move(in));
+  }
+  std::vector<std::string> fleet;
+  if (!pnh_.getParam("fleet", fleet)) {
+    int robots = 1;
+    pnh_.param("num_robots", robots, 1);
+    for (int r = 1; r <= robots; ++r) fleet.push_back("robot_" + std::to_string(r));
+  }
+  for (const std::string& other : fleet)
+    if (other != robot_id_)
+      peer_subs_.push_back(nh_.subscribe("/" + other + "/goal", 5, &NbsPlannerNode::peerGoalCallback, this));
+  std::string battery_topic;
+  pnh_.param<std::string>("battery_topic", battery_topic, "battery");
+  if (!battery_topic.empty()) battery_sub_ = nh_.subscribe(battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
+
+  goal_pub_ = nh_.advertise<picker_localisation::GoalNode>("goal", 1, true);
+  marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("nbs_candidates", 1, true);
+  candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
+  diagnostics_.setHardwareID(robot_id_);
+  diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);
+  timer_ = nh_.createTimer(ros::Duration(period), [this](const ros::TimerEvent&) {
+    planOnce();
+    diagnostics_.update();
+  });
+  ROS_INFO("%s: robot %s, policy %s, %zu pickers, %zu other robots, planning every %.1f s", name.c_str(),
+           robot_id_.c_str(), nbs::toString(config.policy), pickers_.size(), peer_subs_.size(), period);
+  ok_ = true;
+}
+
+void NbsPlannerNode::beliefCallback(std::size_t k, const picker_localisation::PickerBelief::ConstPtr& msg) {
+  PickerInput& in = *pickers_[k];
+  std::size_t rejected = 0;
+  const nbs::NodeMasses masses = massesFromBelief(*msg, *map_, &rejected);
+  if (masses.empty() || msg->picker_id != in.id) {
+    ++in.rejected;
+    ROS_WARN_THROTTLE(10.0, "%s: rejected a belief of %s (%s)", ros::this_node::getName().c_str(), in.id.c_str(),
+                      msg->picker_id != in.id ? ("picker_id '" + msg->picker_id + "'").c_str()
+                                              : "no node of this map with a valid mass");
+    return;
+  }
+  if (rejected > 0) ++in.rejected;
+  ++in.received;
+  in.belief = *msg;
+}
+
+void NbsPlannerNode::peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
+  if (msg->robot_id.empty() || msg->robot_id == robot_id_ || (!msg->node.empty() && !map_->index(msg->node))) {
+    ++peer_goals_rejected_;
+    ROS_WARN_THROTTLE(10.0, "%s: ignored a goal of robot '%s' (node '%s' not in the map or bad robot id)",
+                      ros::this_node::getName().c_str(), msg->robot_id.c_str(), msg->node.c_str());
+    return;
+  }
+  peer_goals_[msg->robot_id] = {*msg, ros::Time::now()};
+}
+
+void NbsPlannerNode::batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg) {
+  if (!std::isfinite(msg->percentage) || msg->percentage < 0.0f || msg->percentage > 1.0f) {
+    ROS_WARN_THROTTLE(10.0, "%s: battery percentage %f is not in [0, 1]; keeping %.2f",
+                      ros::this_node::getName().c_str(), msg->percentage, battery_level_);
+    return;
+  }
+  battery_level_ = msg->percentage;
+}
+
+std::optional<topology::NodeIndex> NbsPlannerNode::robotNode() {
+  try {
+    const geometry_msgs::TransformStamped t =
+        tf_buffer_.lookupTransform(map_frame_, base_frame_, ros::Time(0), ros::Duration(tf_timeout_));
+    const Eigen::Vector2d p(t.transform.translation.x, t.transform.translation.y);
+    if (!p.allFinite()) throw tf2::TransformException("non-finite robot position");
+    return map_->nearestNode(p);
+  } catch (const tf2::TransformException& e) {
+    ++tf_failures_;
+    last_problem_ = std::string("no robot pose: ") + e.what();
+    ROS_WARN_THROTTLE(10.0, "%s: no pose %s -> %s: %s", ros::this_node::getName().c_str(), map_frame_.c_str(),
+                      base_frame_.c_str(), e.what());
+    return std::nullopt;
+  }
+}
+
+void NbsPlannerNode::planOnce() {
+  const ros::Time stamp = ros::Time::now();
+  const auto robot = robotNode();
+  if (!robot) {
+    ++failed_plans_;
+    return;
+  }
+  std::vector<std::unique_ptr<WhatIfBeliefSource>> sources;
+  std::vector<nbs::BeliefSource*> pointers;
+  for (auto& in : pickers_) {
+    if (!in->belief) continue;
+    ros::ServiceClient* client = nullptr;
+    if (use_what_if_ && planner_->config().policy == nbs::Policy::kNextBestSense) {
+      if (!in->what_if.isValid())  // persistent connections do not reconnect by themselves
+        in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + in->id + "/what_if", true);
+      client = &in->what_if;
+    }
+    sources.push_back(std::make_unique<WhatIfBeliefSource>(in->id, map_, *in->belief, client,
+                                                           static_cast<std::uint32_t>(what_if_seed_), map_frame_));
+    pointers.push_back(sources.back().get());
+  }
+  std::vector<nbs::Claim> goals;
+  for (const auto& [id, g] : peer_goals_) {
+    if ((stamp - g.received).toSec() > claim_timeout_ || g.msg.node.empty()) continue;  // stale
+    goals.push_back({id, *map_->index(g.msg.node), g.msg.target_picker});
+  }
+  nbs::PlanResult plan = planner_->plan(*robot, battery_level_, pointers, nbs::claimsFor(robot_id_, goals));
+  bool fallback = false;
+  for (const auto& s : sources)
+    if (s->usedFallback()) {
+      fallback = true;
+      last_what_if_error_ = s->lastError();
+    }
+  if (fallback) {
+    ++fallback_plans_;
+    ROS_WARN_THROTTLE(30.0, "%s: %s; planned with the published belief held still (no prediction)",
+                      ros::this_node::getName().c_str(), last_what_if_error_.c_str());
+  }
+  ++plans_;
+  if (!plan.ok()) {
+    ++failed_plans_;
+    last_problem_ = plan.problem;
+    ROS_WARN_THROTTLE(10.0, "%s: no goal: %s", ros::this_node::getName().c_str(), plan.problem.c_str());
+  } else {
+    last_problem_.clear();
+  }
+  last_plan_ = std::move(plan);
+  last_plan_stamp_ = stamp;
+  publish(*last_plan_, stamp);
+}
+
+void NbsPlannerNode::publish(const nbs::PlanResult& plan, const ros::Time& stamp) {
+  if (plan.ok()) {
+    const nbs::Candidate& best = plan.ranked.front();
+    picker_localisation::GoalNode g;
+    g.header.stamp = stamp;
+    g.header.frame_id = map_frame_;
+    g.robot_id = robot_id_;
+    g.node = map_->node(best.node).name;
+    g.pose = nodePose(map_->node(best.node));
+    g.utility = best.utility;
+    g.policy = nbs::toString(plan.policy);
+    g.target_picker = best.target_picker;
+    goal_pub_.publish(g);
+  }
+  marker_pub_.publish(candidateMarkers(plan, stamp));
+  ++markers_published_;
+}
+
+visualization_msgs::MarkerArray NbsPlannerNode::candidateMarkers(const nbs::PlanResult& plan,
+                                                                 const ros::Time& stamp) const {
+  visualization_msgs::MarkerArray out;
+  visualization_msgs::Marker clear;
+  clear.action = visualization_msgs::Marker::DELETEALL;
+  out.markers.push_back(clear);
+  visualization_msgs::Marker spheres;
+  spheres.header.frame_id = map_frame_;
+  spheres.header.stamp = stamp;
+  spheres.ns = robot_id_ + "/nbs_candidates";
+  spheres.id = 0;
+  spheres.type = visualization_msgs::Marker::SPHERE_LIST;
+  spheres.action = visualization_msgs::Marker::ADD;
+  spheres.pose.orientation.w = 1.0;
+  spheres.scale.x = spheres.scale.y = spheres.scale.z = 0.5;
+  for (const nbs::Candidate& c : plan.ranked) {
+    geometry_msgs::Point p;
+    p.x = map_->node(c.node).position.x();
+    p.y = map_->node(c.node).position.y();
+    p.z = 0.5;
+    spheres.points.push_back(p);
+    spheres.colors.push_back(utilityColour(c.utility));
+  }
+  if (!spheres.points.empty()) out.markers.push_back(spheres);
+  // The five best with their utility as text, the goal as a tall cylinder.
+  for (std::size_t i = 0; i < std::min<std::size_t>(5, plan.ranked.size()); ++i) {
+    const nbs::Candidate& c = plan.ranked[i];
+    visualization_msgs::Marker t;
+    t.header = spheres.header;
+    t.ns = robot_id_ + "/nbs_utilities";
+    t.id = static_cast<int>(i);
+    t.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+    t.pose.position.x = map_->node(c.node).position.x();
+    t.pose.position.y = map_->node(c.node).position.y();
+    t.pose.position.z = 1.2;
+    t.pose.orientation.w = 1.0;
+    t.scale.z = 0.4;
+    t.color.r = t.color.g = t.color.b = t.color.a = 1.0f;
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.2f", c.utility);
+    t.text = text;
+    out.markers.push_back(t);
+  }
+  if (plan.ok()) {
+    visualization_msgs::Marker goal;
+    goal.header = spheres.header;
+    goal.ns = robot_id_ + "/nbs_goal";
+    goal.id = 0;
+    goal.type = visualization_msgs::Marker::CYLINDER;
+    goal.pose = nodePose(map_->node(plan.ranked.front().node));
+    goal.pose.position.z = 1.0;
+    goal.scale.x = goal.scale.y = 0.6;
+    goal.scale.z = 2.0;
+    goal.color.g = 0.6f;
+    goal.color.b = 1.0f;
+    goal.color.a = 0.7f;
+    out.markers.push_back(goal);
+  }
+  return out;
+}
+
+bool NbsPlannerNode::getCandidates(picker_localisation::GetCandidates::Request& req,
+                                   picker_localisation::GetCandidates::Response& res) {
+  if (!last_plan_) planOnce();
+  if (!last_plan_) return true;  // no pose yet: empty answer (diagnostics say why)
+  const nbs::PlanResult& plan = *last_plan_;
+  res.criteria = plan.criteria;
+  const std::size_t n = req.max_candidates == 0 ? plan.ranked.size()
+                                                : std::min<std::size_t>(req.max_candidates, plan.ranked.size());
+  for (std::size_t i = 0; i < n; ++i) {
+    res.nodes.push_back(map_->node(plan.ranked[i].node).name);
+    res.utilities.push_back(plan.ranked[i].utility);
+    res.normalised_criteria.insert(res.normalised_criteria.end(), plan.ranked[i].normalised.begin(),
+                                   plan.ranked[i].normalised.end());
+  }
+  return true;
+}
+
+void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::size_t with_belief = 0;
+  for (const auto& in : pickers_) {
+    if (in->belief) ++with_belief;
+    stat.add("beliefs received " + in->id, in->received);
+    stat.add("beliefs rejected " + in->id, in->rejected);
+  }
+  stat.add("robot id", robot_id_);
+  stat.add("policy", nbs::toString(planner_->config().policy));
+  stat.add("battery level", battery_level_);
+  stat.add("plans", plans_);
+  stat.add("plans without goal", failed_plans_);
+  stat.add("tf failures", tf_failures_);
+  stat.add("plans on the fallback belief (no what-if)", fallback_plans_);
+  stat.add("other robots' goals known", peer_goals_.size());
+  stat.add("other robots' goals rejected", peer_goals_rejected_);
+  if (last_plan_ && last_plan_->ok()) {
+    stat.add("goal", map_->node(last_plan_->ranked.front().node).name);
+    stat.add("goal utility", last_plan_->ranked.front().utility);
+    stat.add("candidates", last_plan_->ranked.size());
+    stat.add("what-if queries", last_plan_->what_if_queries);
+  }
+  if (!last_problem_.empty())
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, last_problem_);
+  else if (with_belief == 0 && planner_->config().policy == nbs::Policy::kEstimatedNode)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no picker belief received yet");
+  else if (!last_what_if_error_.empty() && fallback_plans_ > 0 && last_plan_ && plans_ > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "planning without the what-if service: " + last_what_if_error_);
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "planning");
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation
