@@ -5,3 +5,11 @@ add_library(picker_localisation_tpf
 target_link_libraries(picker_localisation_tpf PUBLIC picker_localisation_core)
 install(TARGETS picker_localisation_tpf ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+# bench_tpf: ns per particle-update versus particle count and map size (Google Benchmark).
+if(benchmark_FOUND)
+  add_executable(bench_tpf src/tools/bench_tpf.cpp)
+  target_link_libraries(bench_tpf picker_localisation_tpf benchmark::benchmark)
+  set_target_properties(bench_tpf PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+  install(TARGETS bench_tpf RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+endif()

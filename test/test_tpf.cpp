@@ -260,8 +260,8 @@ TEST(TpfFilter, Eq1InitialisationFromIdentifyingLikelihood) {
     my += q.vy;
     vx2 += (q.vx - 0.1) * (q.vx - 0.1);
     if (q.node == 5 || q.node == 40) {
-      tau_min = std::min(tau_min, q.dwell);
-      tau_max = std::max(tau_max, q.dwell);
+      tau_min = std::min(tau_min, static_cast<double>(q.dwell));
+      tau_max = std::max(tau_max, static_cast<double>(q.dwell));
     }
   }
   const double n = static_cast<double>(f.particles().size());

@@ -16,14 +16,54 @@ constexpr double kMinEdgeLength = 1e-6;                // m; shorter edges have 
 
 // Uniform double in [0, 1) from 53 random bits.
 inline double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+// Standard normal variates for the resampling noise of Eq. 12 by inverse-transform sampling on a grid:
+// entry i is the quantile Phi^-1((i + 1/2) / 65536), so 16 random bits give one N(0, 1) draw (tails cut at
+// 4.3 sigma, variance 0.9997). One 64-bit draw then serves two velocity components and the dwell noise, which
+// keeps the noise at a few ns per particle instead of ~25 ns with std::normal_distribution.
+constexpr int kNormalTableBits = 16;
+double inverseNormalCdf(double p) {
+  // Safeguarded Newton on Phi(x) - p = 0, Phi(x) = erfc(-x / sqrt 2) / 2: bisection whenever a Newton step
+  // leaves the bracket.
+  double lo = -10.0, hi = 10.0, x = std::clamp(std::log(p / (1.0 - p)) / 1.702, lo, hi);
+  for (int it = 0; it < 200; ++it) {
+    const double err = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
+    if (err < 0.0) lo = x;
+    else hi = x;
+    const double pdf = std::exp(-0.5 * x * x) / std::sqrt(2.0 * M_PI);
+    double next = x - err / pdf;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - x) < 1e-14) return next;
+    x = next;
+  }
+  return x;
+}
+const std::vector<float>& normalTable() {
+  static const std::vector<float> table = [] {
+    const std::size_t n = std::size_t{1} << kNormalTableBits;
+    std::vector<float> t(n);
+    for (std::size_t i = 0; i < n / 2; ++i) {
+      const float x = static_cast<float>(inverseNormalCdf((static_cast<double>(i) + 0.5) / static_cast<double>(n)));
+      t[i] = x;
+      t[n - 1 - i] = -x;  // exact symmetry: zero mean
+    }
+    return t;
+  }();
+  return table;
+}
 }  // namespace
 
 // Compressed adjacency of the motion graph (successors or undirected neighbours) with the unit direction and
 // length of every edge, built once per filter and shared by its copies.
 struct TopologicalParticleFilter::MotionGraph {
+  struct Arc {
+    double ux = 0.0, uy = 0.0;  // unit direction q -> target (0 for a zero-length edge)
+    double length = 0.0;        // m
+    double rate = 0.0;          // 2 log(1/2) / length (lambda of Eq. 6 per m/s of projected speed), 1/m
+    NodeIndex target = topology::kInvalidNode;
+  };
   std::vector<std::uint32_t> offsets;  // |N| + 1
-  std::vector<NodeIndex> targets;
-  std::vector<double> ux, uy, length;
+  std::vector<Arc> arcs;               // grouped by source node
   std::size_t max_degree = 0;
 
   MotionGraph(const topology::TopologicalMap& map, bool directed) {
@@ -36,11 +76,15 @@ struct TopologicalParticleFilter::MotionGraph {
       const Eigen::Vector2d pi = map.position2d(i);
       for (NodeIndex k : nb) {
         const Eigen::Vector2d d = map.position2d(k) - pi;
-        const double len = d.norm();
-        targets.push_back(k);
-        length.push_back(len);
-        ux.push_back(len > kMinEdgeLength ? d.x() / len : 0.0);
-        uy.push_back(len > kMinEdgeLength ? d.y() / len : 0.0);
+        Arc a;
+        a.length = d.norm();
+        a.target = k;
+        if (a.length > kMinEdgeLength) {
+          a.ux = d.x() / a.length;
+          a.uy = d.y() / a.length;
+          a.rate = 2.0 * kLogHalf / a.length;
+        }
+        arcs.push_back(a);
       }
     }
   }
@@ -108,11 +152,11 @@ std::vector<double> TopologicalParticleFilter::transitionProbabilities(NodeIndex
     return out;
   }
   double sum_b = 0.0;
-  for (std::uint32_t e = begin; e < end; ++e) sum_b += std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
+  for (std::uint32_t e = begin; e < end; ++e) sum_b += std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
   if (!(sum_b > 0.0)) return out;
   for (std::uint32_t e = begin; e < end; ++e) {
-    const double b = std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
-    out[e - begin] = b * edgeJumpProbability(lambda(b, g.length[e]), dwell) / sum_b;
+    const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
+    out[e - begin] = b * edgeJumpProbability(lambda(b, g.arcs[e].length), dwell) / sum_b;
   }
   return out;
 }
@@ -131,7 +175,7 @@ double TopologicalParticleFilter::particleWeight(const Particle& p, double norma
   if (obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity) {
     const double vs = obs.velocity->norm();
     const double sigma = std::max(0.5 * vs, params_.min_velocity_sigma);
-    const double speed = std::hypot(static_cast<double>(p.vx), static_cast<double>(p.vy));
+    const double speed = std::sqrt(static_cast<double>(p.vx) * p.vx + static_cast<double>(p.vy) * p.vy);
     const double z = (speed - vs) / sigma;
     const double g = std::exp(-0.5 * z * z);  // Gaussian of Eq. 8, peak 1
     // cos of the angle between the particle and the observed velocity; 0 (no preference) if either is zero.
@@ -258,7 +302,7 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
     }
     p.vx = static_cast<float>(vel(rng_));
     p.vy = static_cast<float>(vel(rng_));
-    p.dwell = params_.dwell_init_min + span * uniform01(rng_);
+    p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
   }
   unconnected_p_ = params_.unconnected_jump_probability;
 }
@@ -269,43 +313,41 @@ void TopologicalParticleFilter::predict(double dt) {
   const double inv_window = 1.0 / params_.velocity_window;
   if (params_.motion_model == MotionModel::kFixedLambda) {
     for (Particle& p : particles_) {
-      const double tau = p.dwell + dt;
+      const double tau = static_cast<double>(p.dwell) + dt;
       const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
       const double u = uniform01(rng_);
       const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
       if (begin == end || !(u < r)) {
-        p.dwell = tau;
+        p.dwell = static_cast<float>(tau);
         continue;
       }
       // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
       const std::uint32_t k = begin + std::min<std::uint32_t>(end - begin - 1,
                                                               static_cast<std::uint32_t>((u / r) * (end - begin)));
-      p.node = g.targets[k];
-      p.dwell = 0.0;
+      p.node = g.arcs[k].target;
+      p.dwell = 0.0f;
     }
     return;
   }
-  thread_local std::vector<double> contrib;
+  std::vector<double>& contrib = edge_scratch_;
   if (contrib.size() < g.max_degree) contrib.resize(g.max_degree);
   for (Particle& p : particles_) {
-    const double tau = p.dwell + dt;
+    const double tau = static_cast<double>(p.dwell) + dt;
     const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
     const double vx = p.vx, vy = p.vy;
     double sum_b = 0.0, sum_c = 0.0;
     for (std::uint32_t e = begin; e < end; ++e) {
-      const double b = std::max(0.0, vx * g.ux[e] + vy * g.uy[e]);
+      const auto& arc = g.arcs[e];
+      const double b = std::max(0.0, vx * arc.ux + vy * arc.uy);
       double c = 0.0;
-      if (b > 0.0) {
-        // b (1 - exp(lambda tau)), lambda of Eq. 6 (length > 0 whenever b > 0).
-        c = b * (1.0 - std::exp(2.0 * kLogHalf * b / g.length[e] * tau));
-      }
+      if (b > 0.0) c = b * (1.0 - std::exp(arc.rate * b * tau));  // b (1 - exp(lambda tau)), Eq. 6
       contrib[e - begin] = c;
       sum_b += b;
       sum_c += c;
     }
     const double u = uniform01(rng_) * sum_b;  // jump with probability sum_c / sum_b (Eq. 2)
     if (!(u < sum_c)) {
-      p.dwell = tau;
+      p.dwell = static_cast<float>(tau);
       continue;
     }
     std::uint32_t e = begin;
@@ -313,11 +355,12 @@ void TopologicalParticleFilter::predict(double dt) {
     while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
     const double pr = contrib[e - begin] / sum_b;  // Pr(q') of the transition taken
     const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
-    const double ox = g.ux[e] * g.length[e] * inv_t, oy = g.uy[e] * g.length[e] * inv_t;
+    const auto& arc = g.arcs[e];
+    const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
     p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
     p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
-    p.node = g.targets[e];
-    p.dwell = 0.0;
+    p.node = arc.target;
+    p.dwell = 0.0f;
   }
 }
 
@@ -374,28 +417,49 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
 }
 
 bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood) {
-  // Eq. 8 per particle, Eq. 9 masses in node_scratch_b_, Eq. 10 MAP.
+  // Eq. 8 per particle (as particleWeight(), constants hoisted) with the Eq. 9 masses accumulated in
+  // node_scratch_b_ in the same pass; Eq. 10 MAP.
   const double inv_max = 1.0 / max_likelihood;
   const SensorGamma gamma = params_.gammaFor(obs.sensor);
   const bool velocity_term =
       obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity;
   const double base = params_.gamma_as_confidence ? 1.0 - gamma.node : 0.0;
-  double total = 0.0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const Particle& p = particles_[i];
-    double w = gamma.node * node_scratch_a_[p.node] * inv_max + base;
-    if (velocity_term) w = particleWeight(p, node_scratch_a_[p.node] * inv_max, obs);
-    weights_[i] = w;
-    total += w;
-  }
-  if (!(total > 0.0) || !std::isfinite(total)) return false;
-
+  const double gq = gamma.node * inv_max;
   std::vector<double>& mass = node_scratch_b_;
   touched_.clear();
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    const NodeIndex n = particles_[i].node;
-    if (mass[n] == 0.0 && weights_[i] > 0.0) touched_.push_back(n);
-    mass[n] += weights_[i];
+  double total = 0.0;
+  auto accumulate = [&](std::size_t i, NodeIndex n, double w) {
+    weights_[i] = w;
+    total += w;
+    if (w > 0.0) {
+      if (mass[n] == 0.0) touched_.push_back(n);
+      mass[n] += w;
+    }
+  };
+  if (!velocity_term) {
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      const NodeIndex n = particles_[i].node;
+      accumulate(i, n, gq * node_scratch_a_[n] + base);
+    }
+  } else {
+    const float ox = static_cast<float>(obs.velocity->x()), oy = static_cast<float>(obs.velocity->y());
+    const float vs = std::sqrt(ox * ox + oy * oy);
+    const float inv_sigma = 1.0f / static_cast<float>(std::max(0.5 * vs, params_.min_velocity_sigma));
+    const float gv4 = static_cast<float>(0.25 * gamma.velocity);
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      const Particle& p = particles_[i];
+      const float speed = std::sqrt(p.vx * p.vx + p.vy * p.vy);
+      const float z = (speed - vs) * inv_sigma;
+      const float denom = speed * vs;
+      const float cosang = denom > 1e-12f ? (p.vx * ox + p.vy * oy) / denom : 0.0f;
+      accumulate(i, p.node,
+                 gq * node_scratch_a_[p.node] + base +
+                     static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f))));
+    }
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) {
+    for (NodeIndex n : touched_) mass[n] = 0.0;
+    return false;
   }
   std::sort(touched_.begin(), touched_.end());
   belief_.nodes.assign(touched_.begin(), touched_.end());
@@ -410,16 +474,10 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     }
     mass[touched_[k]] = 0.0;
   }
-  for (const Particle& p : particles_) mass[p.node] = 0.0;  // nodes whose particles all weighed 0
 
-  resample();  // Eq. 11
-  addNoise();  // Eq. 12
+  resample(total);  // Eq. 11
+  addNoise();       // Eq. 12, leaves the particle counts per node in node_scratch_b_ / touched_
   // Entropy of the resampled particles (Alg. 1 l. 12).
-  touched_.clear();
-  for (const Particle& p : particles_) {
-    if (mass[p.node] == 0.0) touched_.push_back(p.node);
-    mass[p.node] += 1.0;
-  }
   const double inv_n = 1.0 / static_cast<double>(particles_.size());
   double h = 0.0;
   for (NodeIndex n : touched_) {
@@ -432,10 +490,8 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   return true;
 }
 
-void TopologicalParticleFilter::resample() {
+void TopologicalParticleFilter::resample(double total) {
   const std::size_t n = particles_.size();
-  double total = 0.0;
-  for (double w : weights_) total += w;
   if (params_.resampling == ResamplingScheme::kLowVariance) {
     const double step = total / static_cast<double>(n);
     double target = uniform01(rng_) * step;
@@ -463,23 +519,35 @@ void TopologicalParticleFilter::resample() {
 
 void TopologicalParticleFilter::addNoise() {
   // Eq. 12: q ~ U(N) with probability p_rj, v += N(mu_noise, sigma^2_noise), tau += U(tau^-, tau^+) (tau >= 0).
-  const double sigma = std::sqrt(params_.velocity_noise_variance);
-  const double mu = params_.velocity_noise_mean;
-  const double lo = params_.dwell_noise_min, span = params_.dwell_noise_max - params_.dwell_noise_min;
-  std::normal_distribution<double> normal(0.0, 1.0);
-  for (Particle& p : particles_) {
-    p.vx = static_cast<float>(p.vx + mu + sigma * normal(rng_));
-    p.vy = static_cast<float>(p.vy + mu + sigma * normal(rng_));
-    p.dwell = std::max(0.0, p.dwell + lo + span * uniform01(rng_));
-  }
   if (unconnected_p_ > 0.0) {
     // Which particles jump: geometric gaps between jumping particles (same law as one Bernoulli draw each).
     std::geometric_distribution<std::size_t> gap(unconnected_p_);
     const std::size_t n_nodes = map_->numNodes();
     for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
       particles_[i].node = static_cast<NodeIndex>(rng_() % n_nodes);
-      particles_[i].dwell = 0.0;
+      particles_[i].dwell = 0.0f;
     }
+  }
+  // One 64-bit draw per particle: two 16-bit normal-table indices and 32 bits for the dwell noise. The
+  // velocity is left alone by the fixed-lambda model, which neither uses nor estimates it. The same pass
+  // counts the particles per node (node_scratch_b_, touched_) for the entropy.
+  const float sigma = static_cast<float>(std::sqrt(params_.velocity_noise_variance));
+  const float mu = static_cast<float>(params_.velocity_noise_mean);
+  const float lo = static_cast<float>(params_.dwell_noise_min);
+  const float span = static_cast<float>((params_.dwell_noise_max - params_.dwell_noise_min) * 0x1.0p-32);
+  const float* normal = normalTable().data();
+  const bool velocity = params_.motion_model == MotionModel::kVelocity;
+  std::vector<double>& count = node_scratch_b_;
+  touched_.clear();
+  for (Particle& p : particles_) {
+    const std::uint64_t r = rng_();
+    if (velocity) {
+      p.vx += mu + sigma * normal[r & 0xffff];
+      p.vy += mu + sigma * normal[(r >> 16) & 0xffff];
+    }
+    p.dwell = std::max(0.0f, p.dwell + lo + span * static_cast<float>(r >> 32));
+    if (count[p.node] == 0.0) touched_.push_back(p.node);
+    count[p.node] += 1.0;
   }
 }
 

@@ -30,6 +30,7 @@
 //    predicted particles are kept, status kAccepted with reason "no overlap".
 //  * JSD (base-2 logs, so in [0, 1]) and entropy H (nats) over the support present. p_rj follows Algorithm 1:
 //    set to unconnected_jump_probability at start and on re-initialisation, to 0 once H < epsilon_H.
+//  * Eq. 12 velocity noise: inverse-transform sampling on a 65,536-quantile grid of N(0, 1) (speed; see code).
 //  * Late observations: stamp < last update stamp but within reorder_window are fused at the current time
 //    with no prediction (status kReordered); older ones are dropped and counted (kDroppedTooOld). The filter
 //    never predicts backwards.
@@ -48,11 +49,12 @@
 namespace picker_localisation {
 namespace tpf {
 
-// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter).
+// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter). 16 bytes: single
+// precision is ample for speeds (m/s) and dwell times (s) and halves the memory traffic of resampling.
 struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
-  double dwell = 0.0;                                 // tau, s
+  float dwell = 0.0f;                                 // tau, s
 };
 
 enum class UpdateStatus {
@@ -154,7 +156,7 @@ class TopologicalParticleFilter {
   void predict(double dt);
   double observationJsd(const core::Observation& obs, double max_likelihood);
   bool weightAndResample(const core::Observation& obs, double max_likelihood);
-  void resample();
+  void resample(double total_weight);
   void addNoise();
   void recordBelief(bool with_weights);
   void fuse(const core::Observation& obs, double dt, UpdateResult& result);
@@ -171,6 +173,7 @@ class TopologicalParticleFilter {
   // |N|-sized scratch, all zero between calls (touched entries are cleared after use).
   std::vector<double> node_scratch_a_, node_scratch_b_;
   std::vector<topology::NodeIndex> touched_;
+  std::vector<double> edge_scratch_;  // per-edge jump contributions of one particle (max degree)
 
   double unconnected_p_ = 0.0;  // p_rj
   Belief belief_;
