@@ -47,11 +47,11 @@ std::vector<PersonBox> HogPersonDetector::detect(const cv::Mat& bgr) const {
   std::vector<PersonBox> out;
   if (bgr.empty()) return out;
   cv::Mat img = bgr;
-  double factor = 1.0;
-  if (options_.max_width > 0 && bgr.cols > options_.max_width) {
+  double factor = options_.resize > 0.0 ? options_.resize : 1.0;
+  if (options_.max_width > 0 && bgr.cols * factor > options_.max_width)
     factor = static_cast<double>(options_.max_width) / bgr.cols;
-    cv::resize(bgr, img, cv::Size(), factor, factor, cv::INTER_AREA);
-  }
+  if (std::abs(factor - 1.0) > 1e-9)
+    cv::resize(bgr, img, cv::Size(), factor, factor, factor < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
   std::vector<cv::Rect> rects;
   std::vector<double> weights;
   {

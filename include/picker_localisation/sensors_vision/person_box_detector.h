@@ -25,7 +25,9 @@ class PersonBoxDetector {
 struct HogOptions {
   double scale = 1.05;            // detectMultiScale pyramid step
   double hit_threshold = 0.0;     // SVM margin threshold
-  int max_width = 640;            // larger images are downscaled to this width first (boxes are scaled back), px
+  double resize = 1.0;            // image resize factor before detection (boxes are scaled back); > 1 finds people
+                                  // smaller than the 64 x 128 px HOG window
+  int max_width = 1280;           // the resized image is capped at this width, px
   double min_confidence = 0.3;    // boxes below this confidence are dropped
   double nms_iou = 0.4;           // non-maximum suppression overlap
   double confidence_scale = 1.0;  // confidence = 1 - exp(-weight / scale) for the SVM weight
