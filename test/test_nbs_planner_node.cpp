@@ -1,0 +1,235 @@
+// rostest of nbs_planner on the Riseholme map (test/nbs_planner.test): beliefs in, goals / candidates / markers
+// out, the fleet rule across two robots, the EstimatedNode policy, the what-if service path, and that the planner
+// subscribes to no ground-truth topic (asked of the ROS master).
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include <picker_localisation/GetCandidates.h>
+#include <picker_localisation/GoalNode.h>
+#include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/WhatIf.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/topology/map_io.h"
+#include "picker_localisation/tpf/topological_particle_filter.h"
+
+using namespace picker_localisation;
+using topology::NodeIndex;
+
+namespace {
+
+std::shared_ptr<const topology::TopologicalMap> g_map;
+std::unique_ptr<tpf::TopologicalParticleFilter> g_filter;  // picker_2's tracker stand-in
+std::atomic<int> g_what_if_calls{0};
+std::mutex g_mutex;
+std::map<std::string, picker_localisation::GoalNode> g_goals;
+bool g_markers = false;
+NodeIndex g_robot_node = topology::kInvalidNode;
+std::vector<NodeIndex> g_lane_b;  // lane of the uncertain picker_2
+NodeIndex g_confident_node = topology::kInvalidNode;
+
+picker_localisation::PickerBelief beliefMsg(const std::string& id, const std::vector<NodeIndex>& nodes,
+                                            const std::vector<double>& masses, NodeIndex estimate) {
+  picker_localisation::PickerBelief b;
+  b.header.stamp = ros::Time::now();
+  b.header.frame_id = "map";
+  b.picker_id = id;
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    b.nodes.push_back(g_map->node(nodes[k]).name);
+    b.masses.push_back(masses[k]);
+  }
+  b.estimated_node = g_map->node(estimate).name;
+  b.particle_count = 1000;
+  return b;
+}
+
+picker_localisation::PickerBelief beliefMsg(const std::string& id, const tpf::Belief& belief) {
+  return beliefMsg(id, belief.nodes, belief.masses, belief.map_node);
+}
+
+bool whatIf(picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
+  ++g_what_if_calls;
+  std::lock_guard<std::mutex> lock(g_mutex);
+  const tpf::Belief b = req.with_observation
+                            ? g_filter->posteriorUnder(ros_adapter::fromMsg(req.observation, *g_map), req.horizon, req.seed)
+                            : g_filter->predictAhead(req.horizon, req.seed);
+  res.success = true;
+  res.belief = beliefMsg("picker_2", b);
+  return true;
+}
+
+void goalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  g_goals[msg->robot_id] = *msg;
+}
+
+void markerCallback(const visualization_msgs::MarkerArray::ConstPtr& m) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (const auto& mk : m->markers)
+    if (mk.type == visualization_msgs::Marker::SPHERE_LIST && !mk.points.empty()) g_markers = true;
+}
+
+bool waitFor(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    if (done()) return true;
+    ros::WallDuration(0.05).sleep();
+  }
+  return done();
+}
+
+}  // namespace
+
+TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
+  ros::NodeHandle nh;
+  const std::vector<std::string> robots{"robot_1", "robot_2", "robot_3"};
+  std::vector<ros::Subscriber> subs;
+  for (const std::string& r : robots) subs.push_back(nh.subscribe("/" + r + "/goal", 5, goalCallback));
+  subs.push_back(nh.subscribe("/robot_1/nbs_candidates", 1, markerCallback));
+
+  ASSERT_TRUE(waitFor([&] {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    return g_goals.size() == 3 && g_markers;
+  }, 60.0)) << "goals received: " << g_goals.size() << ", markers: " << g_markers;
+  // Goals keep coming every planning period; take fresh ones after the what-if has been used.
+  ASSERT_TRUE(waitFor([] { return g_what_if_calls.load() > 0; }, 20.0)) << "the planner never called the what-if";
+  ros::WallDuration(2.5).sleep();
+  std::map<std::string, picker_localisation::GoalNode> goals;
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    goals = g_goals;
+  }
+  for (const auto& [id, g] : goals) {
+    EXPECT_TRUE(g_map->index(g.node).has_value()) << id << " goal " << g.node;
+    EXPECT_EQ(g.header.frame_id, "map");
+    EXPECT_GE(g.utility, 0.0);
+    EXPECT_LE(g.utility, 1.0 + 1e-9);
+  }
+  // robot_1 (NBS) serves the uncertain picker_2: its goal is within the read range of picker_2's lane.
+  const auto& g1 = goals.at("robot_1");
+  EXPECT_EQ(g1.policy, "nbs");
+  EXPECT_EQ(g1.target_picker, "picker_2");
+  double nearest = 1e9;
+  for (NodeIndex n : g_lane_b) nearest = std::min(nearest, g_map->distance(n, *g_map->index(g1.node)));
+  EXPECT_LE(nearest, 3.0) << "robot_1 goal " << g1.node;
+  // Fleet rule: robot_2 (same pose, lower priority) never takes robot_1's goal.
+  EXPECT_NE(goals.at("robot_2").node, g1.node);
+  // EstimatedNode: robot_3 goes to picker_2's MAP node.
+  EXPECT_EQ(goals.at("robot_3").policy, "estimated_node");
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    EXPECT_EQ(goals.at("robot_3").node, g_map->node(g_filter->belief().map_node).name);
+  }
+
+  // get_candidates: ranked, one normalised row of 4 criteria per node, all in [0, 1].
+  ros::ServiceClient client = nh.serviceClient<picker_localisation::GetCandidates>("/robot_1/get_candidates");
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  picker_localisation::GetCandidates srv;
+  srv.request.max_candidates = 0;
+  ASSERT_TRUE(client.call(srv));
+  ASSERT_EQ(srv.response.criteria.size(), 4u);
+  EXPECT_EQ(srv.response.criteria[2], "rfid_gain");
+  ASSERT_GT(srv.response.nodes.size(), 50u);  // every reachable node of the map but robot_2's claim at most
+  ASSERT_EQ(srv.response.utilities.size(), srv.response.nodes.size());
+  ASSERT_EQ(srv.response.normalised_criteria.size(), 4 * srv.response.nodes.size());
+  for (std::size_t i = 1; i < srv.response.utilities.size(); ++i)
+    EXPECT_GE(srv.response.utilities[i - 1], srv.response.utilities[i]);
+  for (double v : srv.response.normalised_criteria) {
+    EXPECT_GE(v, 0.0);
+    EXPECT_LE(v, 1.0);
+  }
+  srv.request.max_candidates = 5;
+  ASSERT_TRUE(client.call(srv));
+  EXPECT_EQ(srv.response.nodes.size(), 5u);
+}
+
+// The planner may only read beliefs, goals, the battery, tf and the clock: never a ground-truth topic.
+TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
+  XmlRpc::XmlRpcValue args, result, payload;
+  args[0] = ros::this_node::getName();
+  ASSERT_TRUE(ros::master::execute("getSystemState", args, result, payload, true));
+  const XmlRpc::XmlRpcValue& subscribers = payload[1];  // [[topic, [node, ...]], ...]
+  std::map<std::string, std::set<std::string>> by_node;
+  for (int i = 0; i < subscribers.size(); ++i) {
+    XmlRpc::XmlRpcValue entry = subscribers[i];
+    const std::string topic = entry[0];
+    for (int j = 0; j < entry[1].size(); ++j) by_node[std::string(entry[1][j])].insert(topic);
+  }
+  std::size_t planners = 0;
+  for (const auto& [node, topics] : by_node) {
+    if (node.find("nbs_planner") == std::string::npos) continue;
+    ++planners;
+    EXPECT_TRUE(topics.count("/pickers/picker_1/belief")) << node;
+    for (const std::string& t : topics) {
+      EXPECT_EQ(t.find("ground_truth"), std::string::npos) << node << " subscribes to " << t;
+      const bool allowed = (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
+                           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
+                           t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
+      EXPECT_TRUE(allowed) << node << " subscribes to " << t;
+    }
+  }
+  EXPECT_EQ(planners, 3u);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_nbs_planner_node");
+  ros::NodeHandle nh, pnh("~");
+  std::string map_file;
+  pnh.getParam("map_file", map_file);
+  g_map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(map_file));
+
+  // Lanes: picker_1 confident in the first lane, picker_2 uncertain along the last lane, the robots on the
+  // middle node of the lane next to the last one.
+  const auto lane_a = g_map->laneNodes(0);
+  g_lane_b = g_map->laneNodes(static_cast<topology::LaneIndex>(g_map->numLanes() - 1));
+  const auto lane_c = g_map->laneNodes(static_cast<topology::LaneIndex>(g_map->numLanes() - 2));
+  g_confident_node = lane_a[lane_a.size() / 2];
+  g_robot_node = lane_c[lane_c.size() / 2];
+
+  // picker_2's filter: one broad GNSS fix along the middle of lane B.
+  g_filter = std::make_unique<tpf::TopologicalParticleFilter>(g_map, tpf::TpfParams(), 5);
+  core::Observation fix;
+  fix.stamp = 10.0;
+  fix.sensor = "gnss";
+  fix.picker_id = "picker_2";
+  fix.identifying = true;
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Identity() * 25.0;
+  core::setGaussianLikelihood(fix, *g_map, g_map->position2d(g_lane_b[g_lane_b.size() / 2]), cov);
+  g_filter->update(fix);
+
+  ros::ServiceServer what_if = nh.advertiseService("/pickers/picker_2/what_if", whatIf);
+  ros::Publisher b1 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_1/belief", 1, true);
+  ros::Publisher b2 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_2/belief", 1, true);
+  b1.publish(beliefMsg("picker_1", {g_confident_node}, {1.0}, g_confident_node));
+  b2.publish(beliefMsg("picker_2", g_filter->belief()));
+
+  tf2_ros::StaticTransformBroadcaster tf;
+  std::vector<geometry_msgs::TransformStamped> transforms;
+  for (const std::string& r : {"robot_1", "robot_2", "robot_3"}) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = "map";
+    t.child_frame_id = r + "/base_link";
+    t.transform.translation.x = g_map->node(g_robot_node).position.x();
+    t.transform.translation.y = g_map->node(g_robot_node).position.y();
+    t.transform.rotation.w = 1.0;
+    transforms.push_back(t);
+  }
+  tf.sendTransform(transforms);
+
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  const int rc = RUN_ALL_TESTS();
+  spinner.stop();
+  return rc;
+}
