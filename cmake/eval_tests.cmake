@@ -1,2 +1,7 @@
 pl_add_gtest(test_eval_metrics test/test_eval_metrics.cpp LIBS picker_localisation_eval)
 pl_add_gtest(test_ukf_metric test/test_ukf_metric.cpp LIBS picker_localisation_eval)
+pl_add_gtest(test_experiment test/test_experiment.cpp LIBS picker_localisation_experiment)
+if(TARGET picker_localisation_sim)
+  target_link_libraries(test_experiment picker_localisation_sim)
+  target_compile_definitions(test_experiment PRIVATE PL_TEST_HAVE_SIM)
+endif()

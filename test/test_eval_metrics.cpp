@@ -180,3 +180,28 @@ TEST(EvalMetrics, RealRiseholmeMapLanes) {
   EXPECT_TRUE(s.lane_applicable);
   EXPECT_TRUE(s.in_true_lane);
 }
+
+TEST(EvalReport, ErrorTableRows) {
+  const auto map = polytunnel();
+  std::vector<ErrorSample> a = {computeError(map, idx(map, "r2_2"), Eigen::Vector2d(3.0, 6.0)),
+                                computeError(map, idx(map, "r2_2"), Eigen::Vector2d(3.0, 9.0))};
+  const std::string t = errorTable({{"picker_1", a}, {"picker_2", {}}});
+  std::istringstream in(t);
+  std::string header, p1, p2, all;
+  std::getline(in, header);
+  std::getline(in, p1);
+  std::getline(in, p2);
+  std::getline(in, all);
+  EXPECT_NE(header.find("eucl[m]"), std::string::npos);
+  std::istringstream r(p1);
+  std::string id;
+  std::size_t n;
+  double eu, eu_sd, topo, topo_sd, share;
+  r >> id >> n >> eu >> eu_sd >> topo >> topo_sd >> share;
+  EXPECT_EQ(id, "picker_1");
+  EXPECT_EQ(n, 2u);
+  EXPECT_DOUBLE_EQ(eu, 1.5);     // errors 0 and 3
+  EXPECT_DOUBLE_EQ(topo, 0.5);   // hops 0 and 1
+  EXPECT_DOUBLE_EQ(share, 1.0);
+  EXPECT_EQ(all.rfind("all", 0), 0u);
+}

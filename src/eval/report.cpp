@@ -95,6 +95,27 @@ void writeSummaryMarkdown(const std::string& path, const std::string& title,
   if (!f) throw std::runtime_error("error writing '" + path + "'");
 }
 
+std::string errorTable(const std::vector<std::pair<std::string, std::vector<ErrorSample>>>& per_picker) {
+  std::ostringstream f;
+  auto row = [&](const std::string& name, const std::vector<ErrorSample>& samples) {
+    const RunMetrics r = summariseRun(samples);
+    f << std::left << std::setw(14) << name << std::right << std::setw(8) << r.samples << std::setw(10)
+      << num(r.euclidean_mean, 2) << std::setw(9) << num(r.euclidean_std, 2) << std::setw(10)
+      << num(r.topological_mean, 2) << std::setw(9) << num(r.topological_std, 2) << std::setw(11)
+      << num(r.right_lane_share, 3) << '\n';
+  };
+  f << std::left << std::setw(14) << "picker" << std::right << std::setw(8) << "samples" << std::setw(10)
+    << "eucl[m]" << std::setw(9) << "std" << std::setw(10) << "topo[n]" << std::setw(9) << "std" << std::setw(11)
+    << "right_lane" << '\n';
+  std::vector<ErrorSample> all;
+  for (const auto& [id, samples] : per_picker) {
+    row(id, samples);
+    all.insert(all.end(), samples.begin(), samples.end());
+  }
+  row("all", all);
+  return f.str();
+}
+
 ErrorSeries binErrors(const std::string& method, const std::vector<std::vector<ErrorSample>>& runs, double t0,
                       double bin_width) {
   ErrorSeries s;

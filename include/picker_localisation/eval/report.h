@@ -28,6 +28,10 @@ void writeSummaryMarkdown(const std::string& path, const std::string& title,
                           const std::vector<MethodSummary>& rows);
 std::string summaryMarkdown(const std::string& title, const std::vector<MethodSummary>& rows);
 
+// Plain-text table of the errors per picker plus an `all` row (pickers pooled): samples, Euclidean mean/std [m],
+// topological mean/std [nodes], right-lane share. Printed by the evaluator node at shutdown.
+std::string errorTable(const std::vector<std::pair<std::string, std::vector<ErrorSample>>>& per_picker);
+
 // Mean error over time of one method (all runs and pickers, binned).
 struct ErrorSeries {
   std::string method;

@@ -1,0 +1,89 @@
+// The offline Table II experiment runner (Navigate-and-Seek Sec. VI): in-process, deterministic, no roscore.
+// Per run: farm simulator raw measurements -> the real front-end core classes (GnssIngest for fixes,
+// LegDetector on the simulated scans, RfidObservationModel on reads) -> Observations -> one tracker per picker
+// (TopologicalParticleFilter with the method's parameter preset, or the ukf_metric baseline) -> metrics.
+//
+// Scenarios fix the pickers and the default method list:
+//   single      1 picker, 1 robot  (Table II "Single picker")
+//   navigation  1 picker, 1 robot  (Table II "Navigation Strategy")
+//   multi       3 pickers, 1 robot (Table II "Multiple pickers")
+// The robot patrols the lanes (simulator patrol `lanes`) unless the method is a navigation policy
+// (estimated_node, nbs), whose planner then sets the robot's goals.
+// A method whose components are not in this build (or whose data file is missing) is reported unavailable with
+// the reason; it is never run with a substitute.
+#pragma once
+
+#include <cstdint>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/eval/metrics.h"
+#include "picker_localisation/eval/report.h"
+#include "picker_localisation/topology/topological_map.h"
+
+namespace picker_localisation {
+namespace eval {
+
+enum class Scenario { kSingle, kNavigation, kMulti };
+Scenario parseScenario(const std::string& name);  // throws std::invalid_argument
+const char* toString(Scenario s);
+
+// Every method of Table II, in table order.
+const std::vector<std::string>& allMethodNames();
+// The Table II rows of a scenario.
+std::vector<std::string> defaultMethods(Scenario s);
+bool isKnownMethod(const std::string& method);
+
+struct RunConfig {
+  Scenario scenario = Scenario::kSingle;
+  std::string method = "rfid_lidar_gnss";
+  std::uint64_t seed = 1;          // simulator seed of this run; trackers derive theirs from it
+  double duration = 300.0;         // simulated s
+  double sample_period = 1.0;      // s between metric samples (per picker)
+  double step = 0.1;               // s, simulator advance between event merges
+  double lidar_sigma = 0.3;        // m, std of the Gaussian node likelihood of a leg detection
+  double replan_period = 10.0;     // s, navigation policies re-plan at least this often
+  std::string leg_model;           // leg classifier model file (OpenCV YAML); "" = package default
+  std::string tpf_config;          // config/tpf.yaml to start from ("" = Table I defaults)
+};
+
+// "" when `method` can run in this build, else one line saying what is missing.
+std::string methodUnavailableReason(const std::string& method, const RunConfig& config = RunConfig());
+
+struct RunResult {
+  std::vector<ErrorSample> samples;
+  std::size_t observations = 0;    // observations given to trackers
+  std::size_t lidar_detections = 0;
+  double wall_seconds = 0.0;
+};
+
+// One run of one method. Throws std::runtime_error when the method is unavailable.
+RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config);
+
+struct ExperimentConfig {
+  std::string map_path;
+  Scenario scenario = Scenario::kSingle;
+  std::vector<std::string> methods;  // empty: defaultMethods(scenario)
+  std::size_t runs = 10;
+  std::uint64_t seed = 1;            // run k (0-based) uses seed + k, the same for every method
+  double duration = 300.0;
+  std::string out_dir;
+  std::size_t jobs = 1;              // runs executed in parallel (results do not depend on it)
+  RunConfig run;                     // template for the per-run options (scenario/method/seed/duration set here)
+};
+
+struct ExperimentResult {
+  std::vector<MethodSummary> rows;
+  std::vector<ErrorSeries> series;
+  double wall_seconds = 0.0;
+};
+
+// Runs every method `runs` times and writes DIR/<method>/run_<k>.csv, DIR/summary.csv, DIR/summary.md and
+// DIR/errors.png. Progress and unavailable methods are reported on `log`. Throws std::runtime_error on a bad map
+// or an unwritable directory.
+ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log);
+
+}  // namespace eval
+}  // namespace picker_localisation

@@ -1,0 +1,61 @@
+// evaluator node: compares each picker's belief with its simulated ground truth (Navigate-and-Seek Sec. VI
+// metrics, eval::computeError), publishes the live error and prints the error table at shutdown.
+//   subscribes  /pickers/<id>/belief (picker_localisation/PickerBelief), /pickers/<id>/ground_truth
+//               (geometry_msgs/PoseStamped) for every picker of ~pickers_file; the map as ros_adapter::obtainMap
+//   publishes   /pickers/<id>/error (picker_localisation/TrackingError), /diagnostics
+//   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; ROS time s after
+//               which the table is printed and the node exits), ~output_csv ("" none: per-sample CSV at exit)
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <ros/ros.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/PickerBelief.h"
+#include "picker_localisation/eval/metrics.h"
+#include "picker_localisation/topology/topological_map.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+class Evaluator {
+ public:
+  Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  bool ok() const { return ok_; }
+  // The table of every sample so far (eval::errorTable).
+  std::string table() const;
+  // Prints the table (ROS_INFO and stdout) and writes ~output_csv once.
+  void finish();
+  bool done() const { return done_; }
+
+ private:
+  struct Picker {
+    std::string id;
+    std::optional<std::string> estimated_node;
+    std::optional<Eigen::Vector2d> truth;
+    ros::Subscriber belief_sub, truth_sub;
+    ros::Publisher error_pub;
+    std::vector<eval::ErrorSample> samples;
+    std::size_t beliefs = 0, truths = 0, unknown_nodes = 0, not_finite = 0;
+  };
+  void onBelief(std::size_t i, const picker_localisation::PickerBelief::ConstPtr& msg);
+  void onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg);
+  void onTimer(const ros::TimerEvent& ev);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  bool ok_ = false, done_ = false, finished_ = false;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::vector<Picker> pickers_;
+  double duration_ = 0.0;
+  std::string output_csv_;
+  ros::Timer timer_;
+  diagnostic_updater::Updater diagnostics_;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,501 @@
+#include "picker_localisation/eval/experiment.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <mutex>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/eval/ukf_metric_tracker.h"
+#include "picker_localisation/topology/map_io.h"
+
+// Components of other areas: each is compiled in only when its library is part of this build (the eval cmake
+// fragment defines PL_HAVE_<X> from the targets that exist), so a method needing a missing one is reported
+// unavailable instead of being faked.
+#ifdef PL_HAVE_SIM
+#include "picker_localisation/sim/farm_simulator.h"
+#endif
+#ifdef PL_HAVE_TPF
+#include "picker_localisation/tpf/topological_particle_filter.h"
+#endif
+#ifdef PL_HAVE_RANGING
+#include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/rfid_observation_model.h"
+#endif
+#ifdef PL_HAVE_VISION
+#include "picker_localisation/sensors_vision/leg_detector.h"
+#endif
+#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
+#include "picker_localisation/nbs/next_best_sense_planner.h"
+#include "picker_localisation/nbs/tpf_belief_source.h"
+#endif
+
+#ifndef PL_EVAL_PACKAGE_DIR
+#define PL_EVAL_PACKAGE_DIR "."
+#endif
+
+namespace picker_localisation {
+namespace eval {
+
+namespace fs = std::filesystem;
+using topology::NodeIndex;
+
+Scenario parseScenario(const std::string& name) {
+  if (name == "single") return Scenario::kSingle;
+  if (name == "navigation") return Scenario::kNavigation;
+  if (name == "multi") return Scenario::kMulti;
+  throw std::invalid_argument("unknown scenario '" + name + "' (expected single, navigation or multi)");
+}
+
+const char* toString(Scenario s) {
+  switch (s) {
+    case Scenario::kSingle: return "single";
+    case Scenario::kNavigation: return "navigation";
+    case Scenario::kMulti: return "multi";
+  }
+  return "?";
+}
+
+namespace {
+
+enum class Tracker { kTpf, kUkf };
+enum class RobotPolicy { kPatrol, kEstimatedNode, kNbs };
+
+// What a method is made of. The TPF preset names are TpfParams::presetForMethod's.
+struct MethodSpec {
+  std::string name;
+  Tracker tracker = Tracker::kTpf;
+  std::string tpf_preset = "tpf";
+  bool gnss = true, lidar = false, rfid = false;
+  RobotPolicy policy = RobotPolicy::kPatrol;
+};
+
+const std::vector<MethodSpec>& methodSpecs() {
+  static const std::vector<MethodSpec> specs = {
+      {"khan_connected", Tracker::kTpf, "khan_connected", true, false, false, RobotPolicy::kPatrol},
+      {"khan_unconnected", Tracker::kTpf, "khan_unconnected", true, false, false, RobotPolicy::kPatrol},
+      {"lidar_gnss", Tracker::kTpf, "tpf", true, true, false, RobotPolicy::kPatrol},
+      {"rfid_gnss", Tracker::kTpf, "tpf", true, false, true, RobotPolicy::kPatrol},
+      {"rfid_lidar_gnss", Tracker::kTpf, "tpf", true, true, true, RobotPolicy::kPatrol},
+      {"estimated_node", Tracker::kTpf, "tpf", true, true, true, RobotPolicy::kEstimatedNode},
+      {"nbs", Tracker::kTpf, "tpf", true, true, true, RobotPolicy::kNbs},
+      {"ukf_metric", Tracker::kUkf, "", true, true, false, RobotPolicy::kPatrol},
+      {"no_monitor", Tracker::kTpf, "no_monitor", true, true, true, RobotPolicy::kPatrol},
+      {"constant_speed", Tracker::kTpf, "constant_speed", true, true, true, RobotPolicy::kPatrol},
+  };
+  return specs;
+}
+
+const MethodSpec& specOf(const std::string& method) {
+  for (const auto& s : methodSpecs())
+    if (s.name == method) return s;
+  throw std::invalid_argument("unknown method '" + method + "'");
+}
+
+std::string legModelPath(const RunConfig& config) {
+  return config.leg_model.empty() ? std::string(PL_EVAL_PACKAGE_DIR) + "/config/leg_classifier.yml"
+                                  : config.leg_model;
+}
+
+std::size_t numPickers(Scenario s) { return s == Scenario::kMulti ? 3 : 1; }
+
+}  // namespace
+
+const std::vector<std::string>& allMethodNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& s : methodSpecs()) n.push_back(s.name);
+    return n;
+  }();
+  return names;
+}
+
+bool isKnownMethod(const std::string& method) {
+  const auto& n = allMethodNames();
+  return std::find(n.begin(), n.end(), method) != n.end();
+}
+
+std::vector<std::string> defaultMethods(Scenario s) {
+  switch (s) {
+    case Scenario::kSingle:
+      return {"khan_unconnected", "khan_connected", "lidar_gnss", "rfid_gnss", "rfid_lidar_gnss"};
+    case Scenario::kNavigation: return {"estimated_node", "nbs"};
+    case Scenario::kMulti: return {"ukf_metric", "rfid_lidar_gnss", "no_monitor", "constant_speed"};
+  }
+  return {};
+}
+
+std::string methodUnavailableReason(const std::string& method, const RunConfig& config) {
+  if (!isKnownMethod(method)) return "unknown method";
+  const MethodSpec& spec = specOf(method);
+  std::vector<std::string> missing;
+#ifndef PL_HAVE_SIM
+  missing.push_back("the farm simulator (library picker_localisation_sim)");
+#endif
+#ifndef PL_HAVE_RANGING
+  missing.push_back("GnssIngest / RfidObservationModel (sensors_ranging library)");
+#endif
+  if (spec.tracker == Tracker::kTpf) {
+#ifndef PL_HAVE_TPF
+    missing.push_back("the Topological Particle Filter (library picker_localisation_tpf)");
+#endif
+  }
+  if (spec.lidar) {
+#ifndef PL_HAVE_VISION
+    missing.push_back("the LegDetector (library picker_localisation_vision)");
+#else
+    if (!fs::exists(legModelPath(config))) missing.push_back("the leg classifier model " + legModelPath(config));
+#endif
+  }
+  if (spec.policy != RobotPolicy::kPatrol) {
+#ifndef PL_HAVE_NBS
+    missing.push_back("the Next-Best-Sense planner with TpfBeliefSource (library picker_localisation_nbs)");
+#endif
+  }
+  if (missing.empty()) return "";
+  std::string reason = "needs ";
+  for (std::size_t i = 0; i < missing.size(); ++i) reason += (i ? ", " : "") + missing[i];
+  return reason;
+}
+
+#if defined(PL_HAVE_SIM) && defined(PL_HAVE_RANGING)
+namespace {
+
+// One raw measurement of the simulator, for merging the sensor streams into stamp order.
+struct Event {
+  double stamp;
+  int kind;  // 0 gnss, 1 rfid, 2 laser (tie order)
+  std::size_t index;
+};
+
+sensors::GnssFix toIngestFix(const sim::GnssFix& f) {
+  sensors::GnssFix g;
+  g.stamp = f.stamp;
+  g.latitude = f.latitude;
+  g.longitude = f.longitude;
+  g.altitude = f.altitude;
+  g.status = f.status;
+  g.covariance = f.position_covariance;
+  g.covariance_type = f.covariance_type;
+  return g;
+}
+
+sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
+  sensors::DatumConfig c;
+  c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
+  c.latitude = d.latitude;
+  c.longitude = d.longitude;
+  c.altitude = d.altitude;
+  c.heading = d.heading_deg * M_PI / 180.0;
+  return sensors::GeodeticDatum(c);
+}
+
+// The per-picker tracker of a run: a TPF or the picker's view of the shared UKF.
+struct PickerTrack {
+  std::string id;
+#ifdef PL_HAVE_TPF
+  std::unique_ptr<tpf::TopologicalParticleFilter> tpf;
+#endif
+  std::unique_ptr<sensors::GnssIngest> gnss;
+};
+
+}  // namespace
+
+RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config) {
+  const std::string why = methodUnavailableReason(config.method, config);
+  if (!why.empty()) throw std::runtime_error("method " + config.method + " unavailable: " + why);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const MethodSpec& spec = specOf(config.method);
+  RunResult result;
+
+  // --- simulator ---------------------------------------------------------------------------------------
+  sim::SimConfig sc;
+  sc.seed = config.seed;
+  const std::size_t n = numPickers(config.scenario);
+  for (std::size_t i = 0; i < n; ++i) {
+    sim::PickerSpec p;
+    p.id = "picker_" + std::to_string(i + 1);
+    p.rfid_tag = "rfid_000" + std::to_string(i + 1);
+    p.uwb_tag = "uwb_000" + std::to_string(i + 1);
+    sc.pickers.push_back(p);
+  }
+  sc.num_robots = 1;
+  sc.robot_motion.patrol = sim::PatrolPolicy::kLanes;
+  // Sensors a method does not use are switched off (the simulator guarantees that this does not change the
+  // pickers' walks or GNSS errors, so every method of a seed sees the same pickers).
+  sc.enable.gnss = spec.gnss;
+  sc.enable.laser = spec.lidar;
+  sc.enable.rfid = spec.rfid;
+  sc.enable.uwb = false;
+  sc.enable.camera = false;
+  sim::FarmSimulator simulator(*map, sc);
+
+  // --- front-ends --------------------------------------------------------------------------------------
+  const sensors::GeodeticDatum datum = datumOf(simulator.projection().datum());
+  std::vector<PickerTrack> tracks(n);
+  std::vector<core::PickerConfig> registry_entries;
+  for (std::size_t i = 0; i < n; ++i) {
+    const sim::PickerSpec& ps = simulator.pickerSpec(i);
+    tracks[i].id = ps.id;
+    tracks[i].gnss = std::make_unique<sensors::GnssIngest>(ps.id, map, datum);
+    registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag});
+  }
+  const core::PickerRegistry registry(registry_entries);
+  sensors::RfidObservationModel rfid_model(registry, map);
+#ifdef PL_HAVE_VISION
+  std::unique_ptr<sensors::LegDetector> legs;
+  if (spec.lidar) {
+    auto classifier = std::make_shared<sensors::LegClassifier>();
+    classifier->load(legModelPath(config));
+    legs = std::make_unique<sensors::LegDetector>(classifier);
+  }
+#endif
+
+  // --- trackers ----------------------------------------------------------------------------------------
+  UkfMetricTracker ukf;
+#ifdef PL_HAVE_TPF
+  double prediction_period = 4.0;
+  if (spec.tracker == Tracker::kTpf) {
+    tpf::TpfParams base = config.tpf_config.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(config.tpf_config);
+    const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
+    prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
+    for (std::size_t i = 0; i < n; ++i)
+      tracks[i].tpf = std::make_unique<tpf::TopologicalParticleFilter>(map, params,
+                                                                       sim::deriveSeed(config.seed, 1000 + i));
+  }
+#endif
+  auto toTracker = [&](const core::Observation& obs) {
+#ifdef PL_HAVE_TPF
+    for (auto& t : tracks) {
+      if (obs.identifying && obs.picker_id != t.id) continue;
+      if (t.tpf) {
+        t.tpf->update(obs);
+        ++result.observations;
+      }
+    }
+#else
+    (void)obs;
+#endif
+  };
+
+  // --- navigation policy -------------------------------------------------------------------------------
+#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
+  std::unique_ptr<nbs::NextBestSensePlanner> planner;
+  std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources;
+  if (spec.policy != RobotPolicy::kPatrol) {
+    nbs::PlannerConfig pc;
+    pc.policy = spec.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
+    planner = std::make_unique<nbs::NextBestSensePlanner>(map, pc);
+    for (auto& t : tracks) sources.push_back(std::make_unique<nbs::TpfBeliefSource>(t.id, *t.tpf));
+  }
+  double last_plan = -1e300;
+#endif
+
+  // --- main loop ---------------------------------------------------------------------------------------
+  double next_sample = config.sample_period;
+  while (simulator.time() < config.duration - 1e-9) {
+    const double t_next = std::min(config.duration, simulator.time() + config.step);
+    sim::SimOutputs out = simulator.advanceTo(t_next);
+    std::vector<Event> events;
+    for (std::size_t k = 0; k < out.gnss.size(); ++k) events.push_back({out.gnss[k].stamp, 0, k});
+    for (std::size_t k = 0; k < out.rfid.size(); ++k) events.push_back({out.rfid[k].stamp, 1, k});
+    for (std::size_t k = 0; k < out.scans.size(); ++k) events.push_back({out.scans[k].stamp, 2, k});
+    std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
+      return a.stamp != b.stamp ? a.stamp < b.stamp : a.kind < b.kind;
+    });
+    for (const Event& e : events) {
+      if (e.kind == 0) {
+        const sim::GnssFix& f = out.gnss[e.index];
+        PickerTrack& t = tracks.at(f.picker_index);
+        const sensors::GnssResult r = t.gnss->process(toIngestFix(f));
+        if (!r.accepted()) continue;
+        if (spec.tracker == Tracker::kUkf) {
+          Eigen::Matrix2d enu;
+          enu << f.position_covariance[0], f.position_covariance[1], f.position_covariance[3],
+              f.position_covariance[4];
+          const Eigen::Matrix2d cov =
+              f.covariance_type == 0 ? Eigen::Matrix2d::Identity() * 9.0 : datum.enuToMap(enu);
+          ukf.addGnss(f.stamp, t.id, r.position, cov);
+        } else if (r.observation) {
+          toTracker(*r.observation);
+        }
+      } else if (e.kind == 1) {
+        const sim::RfidRead& rr = out.rfid[e.index];
+        sensors::RfidRead read;
+        read.stamp = rr.stamp;
+        read.robot_id = rr.robot_id;
+        read.antenna_id = rr.robot_id + "/" + rr.frame;
+        read.tag_id = rr.tag_id;
+        read.rssi = rr.rssi;
+        sim::Pose2D mount;
+        for (const auto& m : simulator.config().sensor_layout.rfid_antennas)
+          if (m.frame == rr.frame) mount = m.pose;
+        const sim::Pose2D antenna = simulator.robotPose(rr.robot_index).compose(mount);
+        read.antenna_pose = Eigen::Vector3d(antenna.x, antenna.y, antenna.yaw);
+        const sensors::RfidResult r = rfid_model.process(read);
+        if (r.observation) toTracker(*r.observation);
+        for (const auto& neg : r.negative) toTracker(neg);
+      } else {
+#ifdef PL_HAVE_VISION
+        const sim::LaserScan& s = out.scans[e.index];
+        sensors::LaserScanData scan;
+        scan.stamp = s.stamp;
+        scan.angle_min = s.angle_min;
+        scan.angle_increment = s.angle_increment;
+        scan.range_min = s.range_min;
+        scan.range_max = s.range_max;
+        scan.ranges = s.ranges;
+        const sensors::LegDetection det = legs->detect(scan);
+        std::vector<Eigen::Vector2d> people;
+        for (const auto& p : det.people) people.push_back(s.sensor_pose.transform(p.position));
+        result.lidar_detections += people.size();
+        if (spec.tracker == Tracker::kUkf) {
+          ukf.addDetections(s.stamp, people);
+        } else {
+          for (const auto& p : people) {
+            core::Observation obs;
+            obs.stamp = s.stamp;
+            obs.sensor = "lidar";
+            obs.robot_id = s.robot_id;
+            obs.identifying = false;
+            obs.position = p;
+            obs.position_covariance = Eigen::Matrix2d::Identity() * config.lidar_sigma * config.lidar_sigma;
+            core::setGaussianLikelihood(obs, *map, p, obs.position_covariance);
+            toTracker(obs);
+          }
+        }
+#endif
+      }
+    }
+
+    const double now = simulator.time();
+#ifdef PL_HAVE_TPF
+    for (auto& t : tracks)  // periodic prediction when no observation arrives (Table I: 0.25 Hz)
+      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period) t.tpf->predictTo(now);
+#endif
+#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
+    if (planner && (simulator.robot(0).atGoal() || now - last_plan >= config.replan_period)) {
+      std::vector<nbs::BeliefSource*> views;
+      for (auto& s : sources) views.push_back(s.get());
+      const nbs::PlanResult plan = planner->plan(simulator.robot(0).currentNode(), 1.0, views);
+      if (plan.ok()) simulator.setRobotGoal(0, plan.ranked.front().node);
+      last_plan = now;
+    }
+#endif
+    while (next_sample <= now + 1e-9) {
+      for (std::size_t i = 0; i < n; ++i) {
+        NodeIndex est = topology::kInvalidNode;
+#ifdef PL_HAVE_TPF
+        if (tracks[i].tpf && tracks[i].tpf->initialised()) est = tracks[i].tpf->belief().map_node;
+#endif
+        if (spec.tracker == Tracker::kUkf) {
+          if (auto p = ukf.estimate(tracks[i].id)) est = map->nearestNode(*p);
+        }
+        if (est == topology::kInvalidNode) continue;  // no estimate yet (before the first observation)
+        result.samples.push_back(
+            computeError(*map, est, simulator.pickerPose(i).position(), next_sample, tracks[i].id));
+      }
+      next_sample += config.sample_period;
+    }
+  }
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return result;
+}
+#else
+RunResult runOnce(std::shared_ptr<const topology::TopologicalMap>, const RunConfig& config) {
+  throw std::runtime_error("method " + config.method + " unavailable: " +
+                           methodUnavailableReason(config.method, config));
+}
+#endif
+
+ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  auto map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(config.map_path));
+  const std::vector<std::string> methods = config.methods.empty() ? defaultMethods(config.scenario) : config.methods;
+  for (const auto& m : methods)
+    if (!isKnownMethod(m)) throw std::invalid_argument("unknown method '" + m + "'");
+  if (config.runs == 0) throw std::invalid_argument("--runs must be at least 1");
+  if (!(config.duration > 0.0)) throw std::invalid_argument("--duration must be > 0");
+  fs::create_directories(config.out_dir);
+
+  ExperimentResult res;
+  log << "experiment: map " << map->name() << " (" << map->numNodes() << " nodes, " << map->numLanes()
+      << " lanes), scenario " << toString(config.scenario) << ", " << config.runs << " runs, seed " << config.seed
+      << ", " << config.duration << " s simulated, " << config.jobs << " job(s)\n";
+  for (const auto& method : methods) {
+    RunConfig rc = config.run;
+    rc.scenario = config.scenario;
+    rc.method = method;
+    rc.duration = config.duration;
+    const std::string why = methodUnavailableReason(method, rc);
+    if (!why.empty()) {
+      log << "  " << method << ": UNAVAILABLE (" << why << ")\n";
+      res.rows.push_back(unavailableMethod(method, why));
+      continue;
+    }
+    const auto m0 = std::chrono::steady_clock::now();
+    std::vector<RunResult> runs(config.runs);
+    std::vector<std::string> errors(config.runs);
+    std::atomic<std::size_t> next{0};
+    auto worker = [&] {
+      for (std::size_t k = next++; k < config.runs; k = next++) {
+        RunConfig r = rc;
+        r.seed = config.seed + k;
+        try {
+          runs[k] = runOnce(map, r);
+        } catch (const std::exception& e) {
+          errors[k] = e.what();
+        }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t j = 1; j < std::max<std::size_t>(1, std::min(config.jobs, config.runs)); ++j)
+      pool.emplace_back(worker);
+    worker();
+    for (auto& th : pool) th.join();
+    for (std::size_t k = 0; k < config.runs; ++k)
+      if (!errors[k].empty()) throw std::runtime_error("method " + method + " run " + std::to_string(k) + ": " + errors[k]);
+
+    fs::create_directories(fs::path(config.out_dir) / method);
+    std::vector<std::vector<ErrorSample>> samples;
+    for (std::size_t k = 0; k < config.runs; ++k) {
+      writeRunCsv((fs::path(config.out_dir) / method / ("run_" + std::to_string(k) + ".csv")).string(), *map,
+                  runs[k].samples);
+      samples.push_back(std::move(runs[k].samples));
+    }
+    MethodSummary row = summariseMethod(method, samples);
+    res.rows.push_back(row);
+    res.series.push_back(binErrors(method, samples, 0.0, std::max(5.0, config.duration / 100.0)));
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
+    log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean << " ("
+        << row.euclidean_std << ") m, topological " << row.topological_mean << " (" << row.topological_std
+        << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share << std::setprecision(1)
+        << "  [" << secs << " s wall]\n"
+        << std::defaultfloat;
+  }
+  writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
+  std::ostringstream title;
+  title << "Table II, scenario " << toString(config.scenario) << ": map " << map->name() << ", " << config.runs
+        << " runs, seeds " << config.seed << ".." << config.seed + config.runs - 1 << ", " << config.duration
+        << " s simulated";
+  writeSummaryMarkdown((fs::path(config.out_dir) / "summary.md").string(), title.str(), res.rows);
+  if (!res.series.empty()) plotErrors((fs::path(config.out_dir) / "errors.png").string(), res.series);
+  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  log << "experiment: wrote " << config.out_dir << "/summary.csv, summary.md"
+      << (res.series.empty() ? "" : ", errors.png") << " in " << std::setprecision(1) << std::fixed
+      << res.wall_seconds << " s wall\n" << std::defaultfloat;
+  return res;
+}
+
+}  // namespace eval
+}  // namespace picker_localisation

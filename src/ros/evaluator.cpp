@@ -1,0 +1,148 @@
+#include "picker_localisation/ros/evaluator.h"
+
+#include <cmath>
+#include <iostream>
+
+#include "picker_localisation/TrackingError.h"
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/eval/report.h"
+#include "picker_localisation/ros/map_source.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string pickers_file;
+  if (!pnh.getParam("pickers_file", pickers_file) && !nh.getParam("pickers_file", pickers_file)) {
+    ROS_FATAL("evaluator: parameter ~pickers_file (config/pickers.yaml) is required");
+    return;
+  }
+  double sample_rate = 1.0;
+  pnh.param("sample_rate", sample_rate, sample_rate);
+  pnh.param("duration", duration_, 0.0);
+  pnh.param<std::string>("output_csv", output_csv_, "");
+  if (!(sample_rate > 0.0)) {
+    ROS_FATAL("evaluator: ~sample_rate must be > 0 (got %g)", sample_rate);
+    return;
+  }
+  core::PickerRegistry registry;
+  try {
+    registry = core::PickerRegistry::load(pickers_file);
+  } catch (const std::exception& e) {
+    ROS_FATAL("evaluator: %s", e.what());
+    return;
+  }
+  map_ = obtainMap(nh, pnh);
+  if (!map_) return;
+  pickers_.resize(registry.size());
+  for (std::size_t i = 0; i < registry.size(); ++i) {
+    Picker& p = pickers_[i];
+    p.id = registry.pickers()[i].id;
+    const std::string base = "/pickers/" + p.id;
+    p.belief_sub = nh.subscribe<picker_localisation::PickerBelief>(
+        base + "/belief", 10, [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(i, m); });
+    p.truth_sub = nh.subscribe<geometry_msgs::PoseStamped>(
+        base + "/ground_truth", 10, [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) { onTruth(i, m); });
+    p.error_pub = nh.advertise<picker_localisation::TrackingError>(base + "/error", 10);
+  }
+  diagnostics_.setHardwareID("evaluator");
+  diagnostics_.add("evaluator", this, &Evaluator::diagnose);
+  timer_ = nh.createTimer(ros::Duration(1.0 / sample_rate), &Evaluator::onTimer, this);
+  ROS_INFO("evaluator: %zu pickers, map '%s', sampling at %g Hz%s", pickers_.size(), map_->name().c_str(),
+           sample_rate, duration_ > 0.0 ? (", stopping at t = " + std::to_string(duration_) + " s").c_str() : "");
+  ok_ = true;
+}
+
+void Evaluator::onBelief(std::size_t i, const picker_localisation::PickerBelief::ConstPtr& msg) {
+  Picker& p = pickers_[i];
+  ++p.beliefs;
+  if (msg->estimated_node.empty()) return;  // not initialised yet
+  if (!map_->index(msg->estimated_node)) {
+    ++p.unknown_nodes;
+    ROS_WARN_THROTTLE(5.0, "evaluator: belief of %s names unknown node '%s' (ignored)", p.id.c_str(),
+                      msg->estimated_node.c_str());
+    return;
+  }
+  p.estimated_node = msg->estimated_node;
+}
+
+void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg) {
+  Picker& p = pickers_[i];
+  ++p.truths;
+  const Eigen::Vector2d t(msg->pose.position.x, msg->pose.position.y);
+  if (!t.allFinite()) {
+    ++p.not_finite;
+    ROS_WARN_THROTTLE(5.0, "evaluator: non-finite ground truth of %s (ignored)", p.id.c_str());
+    return;
+  }
+  p.truth = t;
+}
+
+void Evaluator::onTimer(const ros::TimerEvent& ev) {
+  if (done_) return;
+  const ros::Time now = ev.current_expected;
+  for (Picker& p : pickers_) {
+    if (!p.estimated_node || !p.truth) continue;
+    const eval::ErrorSample s = eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, now.toSec(), p.id);
+    p.samples.push_back(s);
+    picker_localisation::TrackingError msg;
+    msg.header.stamp = now;
+    msg.header.frame_id = "map";
+    msg.picker_id = p.id;
+    msg.estimated_node = *p.estimated_node;
+    msg.true_node = map_->node(s.true_node).name;
+    msg.euclidean_error = s.euclidean;
+    msg.topological_error = s.topological;
+    msg.in_true_lane = s.in_true_lane;
+    p.error_pub.publish(msg);
+  }
+  diagnostics_.update();
+  if (duration_ > 0.0 && now.toSec() >= duration_) {
+    done_ = true;
+    finish();
+    ros::shutdown();
+  }
+}
+
+std::string Evaluator::table() const {
+  std::vector<std::pair<std::string, std::vector<eval::ErrorSample>>> rows;
+  for (const Picker& p : pickers_) rows.emplace_back(p.id, p.samples);
+  return eval::errorTable(rows);
+}
+
+void Evaluator::finish() {
+  if (finished_ || !ok_) return;
+  finished_ = true;
+  const std::string t = table();
+  std::cout << "\n== evaluator: tracking errors (" << map_->name() << ") ==\n" << t << std::flush;
+  if (!output_csv_.empty()) {
+    std::vector<eval::ErrorSample> all;
+    for (const Picker& p : pickers_) all.insert(all.end(), p.samples.begin(), p.samples.end());
+    try {
+      eval::writeRunCsv(output_csv_, *map_, all);
+    } catch (const std::exception& e) {
+      std::cerr << "evaluator: " << e.what() << "\n";
+    }
+  }
+}
+
+void Evaluator::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::size_t waiting = 0, rejected = 0;
+  for (const Picker& p : pickers_) {
+    stat.add(p.id + " beliefs", p.beliefs);
+    stat.add(p.id + " ground truths", p.truths);
+    stat.add(p.id + " samples", p.samples.size());
+    if (!p.estimated_node || !p.truth) ++waiting;
+    rejected += p.unknown_nodes + p.not_finite;
+  }
+  stat.add("rejected messages", rejected);
+  if (rejected > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "rejected beliefs / ground truths (see counts)");
+  else if (waiting > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, std::to_string(waiting) + " picker(s) without belief or truth");
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "evaluating");
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

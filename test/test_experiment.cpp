@@ -1,0 +1,172 @@
+// The offline Table II runner: determinism (same seed -> same summary, whatever the number of jobs), output
+// files, unavailable methods reported, any map format, ground truth equal to the simulator's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "picker_localisation/eval/experiment.h"
+#include "picker_localisation/topology/map_io.h"
+#include "picker_localisation/topology/synthetic_map.h"
+#ifdef PL_TEST_HAVE_SIM
+#include "picker_localisation/sim/farm_simulator.h"
+#endif
+
+using namespace picker_localisation;
+using namespace picker_localisation::eval;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// Writes the synthetic polytunnel as a tmap2 file (nodes, poses, edges, row tags).
+std::string writeSyntheticTmap2(const fs::path& dir) {
+  topology::PolytunnelSpec spec;
+  spec.lanes = 6;
+  spec.nodes_per_lane = 8;
+  const topology::TopologicalMap map = topology::makePolytunnelMap(spec);
+  std::ostringstream y;
+  y << "name: synthetic_test\nmetric_map: synthetic_test\nnodes:\n";
+  for (topology::NodeIndex i = 0; i < map.numNodes(); ++i) {
+    const auto& n = map.node(i);
+    y << "- meta:\n    node: " << n.name << "\n";
+    if (!n.tags.empty()) y << "    tag: [" << n.tags[0] << "]\n";
+    y << "  node:\n    name: " << n.name << "\n    pose:\n      position: {x: " << n.position.x()
+      << ", y: " << n.position.y() << ", z: 0.0}\n      orientation: {x: 0, y: 0, z: 0, w: 1}\n    edges:\n";
+    for (const auto& e : map.edges())
+      if (e.source == i)
+        y << "    - {edge_id: " << e.id << ", node: " << map.node(e.target).name << ", action: " << e.action << "}\n";
+  }
+  const fs::path path = dir / "synthetic_test.tmap2";
+  std::ofstream(path) << y.str();
+  return path.string();
+}
+
+fs::path tempDir(const std::string& name) {
+  const fs::path p = fs::path(testing::TempDir()) / ("pl_experiment_" + name);
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p;
+}
+
+}  // namespace
+
+TEST(Experiment, MethodsAndScenarios) {
+  EXPECT_EQ(allMethodNames().size(), 10u);
+  EXPECT_TRUE(isKnownMethod("ukf_metric"));
+  EXPECT_FALSE(isKnownMethod("bogus"));
+  EXPECT_EQ(methodUnavailableReason("bogus"), "unknown method");
+  EXPECT_THROW(parseScenario("double"), std::invalid_argument);
+  EXPECT_EQ(defaultMethods(Scenario::kNavigation), (std::vector<std::string>{"estimated_node", "nbs"}));
+  EXPECT_EQ(defaultMethods(Scenario::kMulti).size(), 4u);
+  EXPECT_EQ(defaultMethods(Scenario::kSingle).size(), 5u);
+}
+
+TEST(Experiment, SameSeedSameSummaryAnyJobs) {
+  if (!methodUnavailableReason("khan_connected").empty()) GTEST_SKIP() << methodUnavailableReason("khan_connected");
+  const fs::path dir = tempDir("determinism");
+  ExperimentConfig c;
+  c.map_path = writeSyntheticTmap2(dir);
+  c.scenario = Scenario::kSingle;
+  c.methods = {"khan_connected", "rfid_gnss", "ukf_metric"};
+  c.runs = 2;
+  c.seed = 11;
+  c.duration = 60.0;
+  std::ostringstream log1, log2;
+  c.out_dir = (dir / "a").string();
+  c.jobs = 2;
+  const ExperimentResult r1 = runExperiment(c, log1);
+  c.out_dir = (dir / "b").string();
+  c.jobs = 1;
+  runExperiment(c, log2);
+  const std::string s1 = slurp(dir / "a" / "summary.csv");
+  EXPECT_EQ(s1, slurp(dir / "b" / "summary.csv"));
+  EXPECT_EQ(slurp(dir / "a" / "khan_connected" / "run_1.csv"), slurp(dir / "b" / "khan_connected" / "run_1.csv"));
+  EXPECT_EQ(s1.substr(0, s1.find('\n')),
+            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
+  EXPECT_TRUE(fs::exists(dir / "a" / "summary.md"));
+  EXPECT_TRUE(fs::exists(dir / "a" / "errors.png"));
+  ASSERT_EQ(r1.rows.size(), 3u);
+  for (const auto& row : r1.rows) {
+    if (!row.available) continue;
+    EXPECT_EQ(row.runs, 2u);
+    EXPECT_TRUE(std::isfinite(row.euclidean_mean));
+    EXPECT_GE(row.topological_mean, 0.0);
+  }
+  // A different seed gives different pickers, so different numbers.
+  c.seed = 12;
+  c.out_dir = (dir / "c").string();
+  std::ostringstream log3;
+  runExperiment(c, log3);
+  EXPECT_NE(s1, slurp(dir / "c" / "summary.csv"));
+}
+
+TEST(Experiment, UnavailableMethodIsReportedNotRun) {
+  const fs::path dir = tempDir("unavailable");
+  ExperimentConfig c;
+  c.map_path = std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2";
+  c.scenario = Scenario::kSingle;
+  c.methods = {"lidar_gnss"};
+  c.runs = 1;
+  c.duration = 10.0;
+  c.out_dir = dir.string();
+  c.run.leg_model = "/nonexistent/leg_classifier.yml";  // the LiDAR front-end cannot be built
+  std::ostringstream log;
+  const ExperimentResult r = runExperiment(c, log);
+  ASSERT_EQ(r.rows.size(), 1u);
+  EXPECT_FALSE(r.rows[0].available);
+  EXPECT_NE(log.str().find("lidar_gnss: UNAVAILABLE ("), std::string::npos);
+  EXPECT_NE(slurp(dir / "summary.csv").find("lidar_gnss,0,unavailable,unavailable"), std::string::npos);
+  EXPECT_NE(slurp(dir / "summary.md").find("unavailable: needs"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "lidar_gnss"));
+  RunConfig rc = c.run;
+  rc.method = "lidar_gnss";
+  EXPECT_THROW(runOnce(std::make_shared<const topology::TopologicalMap>(topology::loadMap(c.map_path)), rc),
+               std::runtime_error);
+  c.methods = {"bogus"};
+  EXPECT_THROW(runExperiment(c, log), std::invalid_argument);
+}
+
+#ifdef PL_TEST_HAVE_SIM
+TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
+  if (!methodUnavailableReason("khan_connected").empty()) GTEST_SKIP() << methodUnavailableReason("khan_connected");
+  auto map = std::make_shared<const topology::TopologicalMap>(
+      topology::loadMap(std::string(PL_SHARED_DATA) + "/topomaps/riseholme_sim.tmap"));
+  RunConfig rc;
+  rc.scenario = Scenario::kMulti;
+  rc.method = "khan_connected";
+  rc.seed = 5;
+  rc.duration = 30.0;
+  const RunResult r = runOnce(map, rc);
+  ASSERT_FALSE(r.samples.empty());
+  // The truth of a sample is the simulator's picker pose at that time (same seed; the pickers do not depend on
+  // the sensors switched on).
+  sim::SimConfig sc;
+  sc.seed = 5;
+  for (int i = 1; i <= 3; ++i) {
+    sim::PickerSpec p;
+    p.id = "picker_" + std::to_string(i);
+    p.rfid_tag = "rfid_000" + std::to_string(i);
+    p.uwb_tag = "uwb_000" + std::to_string(i);
+    sc.pickers.push_back(p);
+  }
+  sim::FarmSimulator simulator(*map, sc);
+  std::size_t checked = 0;
+  for (const auto& s : r.samples) {
+    if (s.stamp > simulator.time() + 1e-9) simulator.advanceTo(s.stamp);
+    const std::size_t i = *simulator.pickerIndex(s.picker_id);
+    EXPECT_NEAR((s.true_position - simulator.pickerPose(i).position()).norm(), 0.0, 1e-9) << s.stamp;
+    EXPECT_NEAR(s.euclidean, (map->position2d(s.estimated_node) - s.true_position).norm(), 1e-9);
+    ++checked;
+  }
+  EXPECT_GT(checked, 60u);  // 3 pickers, ~30 samples each (after the first fix)
+}
+#endif
