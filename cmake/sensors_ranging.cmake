@@ -18,3 +18,18 @@ if(benchmark_FOUND)
     install(TARGETS bench_rhf RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
   endif()
 endif()
+
+# ROS adapters and nodes.
+add_library(picker_localisation_sensors_ranging_ros
+  src/ros/ranging_ros_common.cpp
+  src/ros/gnss_ingest_ros.cpp
+  src/ros/rfid_ranging_ros.cpp
+  src/ros/uwb_ranging_ros.cpp)
+target_link_libraries(picker_localisation_sensors_ranging_ros PUBLIC picker_localisation_ros picker_localisation_sensors_ranging)
+add_dependencies(picker_localisation_sensors_ranging_ros ${PROJECT_NAME}_generate_messages_cpp)
+install(TARGETS picker_localisation_sensors_ranging_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+foreach(node gnss_ingest rfid_ranging uwb_ranging)
+  pl_add_node(${node} src/nodes/${node}_node.cpp)
+  target_link_libraries(${node} picker_localisation_sensors_ranging_ros)
+endforeach()

@@ -1,0 +1,120 @@
+// ROS adapters of the sensors_ranging front-ends (thin: parameters -> core objects, messages -> core types ->
+// picker_localisation/Observation on /observations). Parameters and topics: docs/readme/sensors_ranging.md and
+// config/gnss_ingest.yaml, config/rfid_ranging.yaml, config/uwb_ranging.yaml.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <picker_localisation/BearingDetectionArray.h>
+#include <picker_localisation/RfidReading.h>
+#include <picker_localisation/UwbRange.h>
+#include <ros/ros.h>
+#include <sensor_msgs/NavSatFix.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/rfid_observation_model.h"
+#include "picker_localisation/sensors_ranging/uwb_ranging.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+// sensor_msgs/NavSatFix -> core GnssFix (no checks: GnssIngest does them).
+sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg);
+
+// Looks up `target <- source` at `stamp`, waiting at most `timeout` s. nullopt (and *error set) when the
+// transform is not available (unknown frame, extrapolation, empty frame id).
+std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, const std::string& target,
+                                                 const std::string& source, const ros::Time& stamp,
+                                                 double timeout, std::string* error);
+// Planar part of a 3D transform: x, y and the yaw of the x axis.
+Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
+
+// gnss_ingest: one NavSatFix subscription per picker (config/pickers.yaml gnss_topic).
+class GnssIngestNode {
+ public:
+  GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  bool ok() const { return ok_; }
+
+ private:
+  void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t picker);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  bool ok_ = false;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::string frame_id_;
+  std::vector<sensors::GnssIngest> ingest_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher pub_;
+  diagnostic_updater::Updater updater_;
+  ros::Timer diag_timer_;
+  std::size_t published_ = 0;
+};
+
+// rfid_ranging: RfidReading -> antenna pose from tf at the read's stamp -> RfidObservationModel.
+class RfidRangingNode {
+ public:
+  RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  bool ok() const { return ok_; }
+
+ private:
+  void onReading(const picker_localisation::RfidReading::ConstPtr& msg);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  bool ok_ = false;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::string map_frame_;
+  double tf_timeout_ = 0.2;
+  std::unique_ptr<sensors::RfidObservationModel> model_;
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher pub_;
+  diagnostic_updater::Updater updater_;
+  ros::Timer diag_timer_;
+  std::size_t tf_failures_ = 0, published_ = 0;
+};
+
+// uwb_ranging: UwbRange (+ optional camera BearingDetectionArray) -> anchors / cameras in base_link and the
+// robot pose in the map from tf -> UwbRanging (a Range Histogram Filter per tag).
+class UwbRangingNode {
+ public:
+  UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  bool ok() const { return ok_; }
+
+ private:
+  void onRange(const picker_localisation::UwbRange::ConstPtr& msg);
+  void onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg);
+  void onFlush(const ros::TimerEvent&);
+  void publish(const std::vector<core::Observation>& obs);
+  std::string baseFrame(const std::string& robot_id) const;
+  // Mount of a sensor frame in base_link (cached: mounts are static).
+  std::optional<Eigen::Isometry2d> mount(const std::string& base, const std::string& frame, const ros::Time& stamp,
+                                         std::string* error);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  bool ok_ = false;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::string map_frame_, base_frame_;
+  double tf_timeout_ = 0.2;
+  std::unique_ptr<sensors::UwbRanging> uwb_;
+  tf2_ros::Buffer tf_buffer_;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
+  std::map<std::string, Eigen::Isometry2d> mounts_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher pub_;
+  ros::Timer flush_timer_;
+  diagnostic_updater::Updater updater_;
+  ros::Timer diag_timer_;
+  std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,106 @@
+#include <cmath>
+#include <sstream>
+
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/ranging_nodes.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string pickers_file, datum_file;
+  if (!pnh.getParam("pickers_file", pickers_file) || !pnh.getParam("datum_file", datum_file)) {
+    ROS_FATAL("gnss_ingest: parameters ~pickers_file (config/pickers.yaml) and ~datum_file (config/datum.yaml) are required");
+    return;
+  }
+  core::PickerRegistry registry;
+  std::unique_ptr<sensors::GeodeticDatum> datum;
+  try {
+    registry = core::PickerRegistry::load(pickers_file);
+    datum = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
+  } catch (const std::exception& e) {
+    ROS_FATAL("gnss_ingest: %s", e.what());
+    return;
+  }
+  sensors::GnssIngestOptions o;
+  int window = static_cast<int>(o.velocity_window), max_nodes = 0, reset = static_cast<int>(o.jump_reset_count);
+  pnh.param("default_sigma", o.default_sigma, o.default_sigma);
+  pnh.param("min_sigma", o.min_sigma, o.min_sigma);
+  pnh.param("cutoff_sigmas", o.cutoff_sigmas, o.cutoff_sigmas);
+  pnh.param("max_nodes", max_nodes, max_nodes);
+  pnh.param("velocity_window", window, window);
+  pnh.param("max_speed", o.max_speed, o.max_speed);
+  pnh.param("jump_gate_sigmas", o.jump_gate_sigmas, o.jump_gate_sigmas);
+  pnh.param("jump_reset_count", reset, reset);
+  pnh.param("blackout_timeout", o.blackout_timeout, o.blackout_timeout);
+  o.max_nodes = static_cast<std::size_t>(std::max(max_nodes, 0));
+  o.velocity_window = static_cast<std::size_t>(std::max(window, 0));
+  o.jump_reset_count = static_cast<std::size_t>(std::max(reset, 0));
+  pnh.param<std::string>("frame_id", frame_id_, "map");
+  double map_timeout = 30.0;
+  pnh.param("map_timeout", map_timeout, map_timeout);
+  map_ = obtainMap(nh, pnh, map_timeout);
+  if (!map_) return;
+
+  std::string topic;
+  pnh.param<std::string>("observation_topic", topic, "/observations");
+  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  for (const core::PickerConfig& p : registry.pickers()) {
+    if (p.gnss_topic.empty()) continue;
+    ingest_.emplace_back(p.id, map_, *datum, o);
+    const std::size_t i = ingest_.size() - 1;
+    subs_.push_back(nh.subscribe<sensor_msgs::NavSatFix>(
+        p.gnss_topic, 50, [this, i](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, i); }));
+    ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
+  }
+  if (ingest_.empty()) ROS_WARN("gnss_ingest: no picker in %s has a gnss_topic", pickers_file.c_str());
+  updater_.setHardwareID("gnss_ingest");
+  updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
+  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  ok_ = true;
+}
+
+void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t i) {
+  sensors::GnssIngest& g = ingest_[i];
+  sensors::GnssResult r = g.process(gnssFixFromMsg(*msg));
+  if (!r.accepted()) {
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(),
+                      msg->header.stamp.toSec(), sensors::toString(r.rejection), r.reason.c_str());
+    return;
+  }
+  if (r.blackout_ended > 0.0)
+    ROS_INFO("gnss_ingest: %s: GNSS back after a %.1f s blackout", g.pickerId().c_str(), r.blackout_ended);
+  pub_.publish(toMsg(*r.observation, *map_, frame_id_));
+  ++published_;
+}
+
+void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const double now = ros::Time::now().toSec();
+  std::size_t blackout = 0, rejected = 0;
+  for (const sensors::GnssIngest& g : ingest_) {
+    const sensors::GnssCounters& c = g.counters();
+    const std::string k = g.pickerId() + " ";
+    stat.add(k + "received", c.received);
+    stat.add(k + "accepted", c.accepted);
+    stat.add(k + "rejected no_fix/not_finite/negative_cov/out_of_order/jump",
+             std::to_string(c.no_fix) + "/" + std::to_string(c.not_finite) + "/" + std::to_string(c.negative_covariance) +
+                 "/" + std::to_string(c.out_of_order) + "/" + std::to_string(c.impossible_jump));
+    stat.add(k + "blackouts (ended)", c.blackouts);
+    stat.add(k + "longest blackout [s]", c.longest_blackout);
+    const double age = g.ageOfLastFix(now);
+    stat.add(k + "age of last fix [s]", std::isfinite(age) ? age : -1.0);
+    if (g.inBlackout(now)) ++blackout;
+    rejected += c.received - c.accepted;
+  }
+  stat.add("published", published_);
+  if (blackout > 0)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%zu picker(s) in GNSS blackout", blackout);
+  else if (rejected > 0)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu fix(es) rejected so far", rejected);
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,58 @@
+#include <tf2/exceptions.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "picker_localisation/ros/ranging_nodes.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg) {
+  sensors::GnssFix f;
+  f.stamp = msg.header.stamp.toSec();
+  f.latitude = msg.latitude;
+  f.longitude = msg.longitude;
+  f.altitude = msg.altitude;
+  f.status = msg.status.status;
+  for (std::size_t i = 0; i < 9; ++i) f.covariance[i] = msg.position_covariance[i];
+  f.covariance_type = msg.position_covariance_type;
+  return f;
+}
+
+std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, const std::string& target,
+                                                 const std::string& source, const ros::Time& stamp,
+                                                 double timeout, std::string* error) {
+  if (source.empty() || target.empty()) {
+    if (error) *error = "empty frame id";
+    return std::nullopt;
+  }
+  try {
+    const geometry_msgs::TransformStamped t =
+        buffer.lookupTransform(target, source, stamp, ros::Duration(std::max(timeout, 0.0)));
+    Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+    out.translation() << t.transform.translation.x, t.transform.translation.y, t.transform.translation.z;
+    const auto& q = t.transform.rotation;
+    Eigen::Quaterniond eq(q.w, q.x, q.y, q.z);
+    if (!(eq.norm() > 0.0) || !out.translation().allFinite()) {
+      if (error) *error = "transform is not finite";
+      return std::nullopt;
+    }
+    out.linear() = eq.normalized().toRotationMatrix();
+    return out;
+  } catch (const tf2::TransformException& e) {
+    if (error) *error = e.what();
+    return std::nullopt;
+  }
+}
+
+Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
+  Eigen::Isometry2d p = Eigen::Isometry2d::Identity();
+  p.translation() = t.translation().head<2>();
+  const double yaw = std::atan2(t.linear()(1, 0), t.linear()(0, 0));
+  p.linear() = Eigen::Rotation2Dd(yaw).toRotationMatrix();
+  return p;
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,108 @@
+#include <cmath>
+
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/ranging_nodes.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string pickers_file;
+  if (!pnh.getParam("pickers_file", pickers_file)) {
+    ROS_FATAL("rfid_ranging: parameter ~pickers_file (config/pickers.yaml) is required");
+    return;
+  }
+  core::PickerRegistry registry;
+  try {
+    registry = core::PickerRegistry::load(pickers_file);
+  } catch (const std::exception& e) {
+    ROS_FATAL("rfid_ranging: %s", e.what());
+    return;
+  }
+  sensors::RfidModelOptions o;
+  pnh.param("read_range", o.read_range, o.read_range);
+  pnh.param("beam_half_angle", o.beam_half_angle, o.beam_half_angle);
+  pnh.param("min_rssi", o.min_rssi, o.min_rssi);
+  pnh.param("negative_information", o.negative_information, o.negative_information);
+  pnh.param("negative_window", o.negative_window, o.negative_window);
+  pnh.param("negative_period", o.negative_period, o.negative_period);
+  pnh.param("p_detect", o.p_detect, o.p_detect);
+  pnh.param("out_of_order_tolerance", o.out_of_order_tolerance, o.out_of_order_tolerance);
+  pnh.param<std::string>("map_frame", map_frame_, "map");
+  pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
+  double map_timeout = 30.0;
+  pnh.param("map_timeout", map_timeout, map_timeout);
+  map_ = obtainMap(nh, pnh, map_timeout);
+  if (!map_) return;
+  try {
+    model_ = std::make_unique<sensors::RfidObservationModel>(registry, map_, o);
+  } catch (const std::exception& e) {
+    ROS_FATAL("rfid_ranging: %s", e.what());
+    return;
+  }
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
+  std::string topic;
+  pnh.param<std::string>("observation_topic", topic, "/observations");
+  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  std::vector<std::string> topics{"rfid"};
+  pnh.param("rfid_topics", topics, topics);
+  for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
+  updater_.setHardwareID("rfid_ranging");
+  updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);
+  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  ok_ = true;
+}
+
+void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
+  std::string error;
+  const std::optional<Eigen::Isometry3d> t =
+      lookupTransform(tf_buffer_, map_frame_, msg->header.frame_id, msg->header.stamp, tf_timeout_, &error);
+  if (!t) {
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "rfid_ranging: read of '%s' dropped: no tf %s <- '%s' at %.3f (%s); %zu dropped so far",
+                      msg->tag_id.c_str(), map_frame_.c_str(), msg->header.frame_id.c_str(),
+                      msg->header.stamp.toSec(), error.c_str(), tf_failures_);
+    return;
+  }
+  const Eigen::Isometry2d p = planar(*t);
+  sensors::RfidRead read;
+  read.stamp = msg->header.stamp.toSec();
+  read.robot_id = msg->robot_id;
+  read.antenna_id = msg->header.frame_id;
+  read.tag_id = msg->tag_id;
+  read.antenna_pose << p.translation(), std::atan2(p.linear()(1, 0), p.linear()(0, 0));
+  read.rssi = msg->rssi;
+  sensors::RfidResult r = model_->process(read);
+  if (!r.accepted()) {
+    ROS_WARN_THROTTLE(5.0, "rfid_ranging: read rejected (%s): %s", sensors::toString(r.rejection), r.reason.c_str());
+    return;
+  }
+  pub_.publish(toMsg(*r.observation, *map_, map_frame_));
+  ++published_;
+  for (const core::Observation& n : r.negative) {
+    pub_.publish(toMsg(n, *map_, map_frame_));
+    ++published_;
+  }
+}
+
+void RfidRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const sensors::RfidCounters& c = model_->counters();
+  stat.add("received", c.received + tf_failures_);
+  stat.add("accepted", c.accepted);
+  stat.add("dropped: no tf", tf_failures_);
+  stat.add("rejected: unknown tag", c.unknown_tag);
+  stat.add("rejected: not finite", c.not_finite);
+  stat.add("rejected: weak signal", c.weak_signal);
+  stat.add("rejected: out of order", c.out_of_order);
+  stat.add("negative observations", c.negative_sent);
+  stat.add("published", published_);
+  const std::size_t bad = tf_failures_ + c.unknown_tag + c.not_finite + c.out_of_order;
+  if (c.accepted == 0 && bad > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no usable RFID reads yet");
+  else
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu read(s) dropped or rejected", bad);
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

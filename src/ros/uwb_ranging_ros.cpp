@@ -1,0 +1,179 @@
+#include <cmath>
+
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/ranging_nodes.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+  std::string pickers_file;
+  if (!pnh.getParam("pickers_file", pickers_file)) {
+    ROS_FATAL("uwb_ranging: parameter ~pickers_file (config/pickers.yaml) is required");
+    return;
+  }
+  core::PickerRegistry registry;
+  try {
+    registry = core::PickerRegistry::load(pickers_file);
+  } catch (const std::exception& e) {
+    ROS_FATAL("uwb_ranging: %s", e.what());
+    return;
+  }
+  sensors::UwbRangingOptions o;
+  sensors::RhfOptions& h = o.rhf;
+  pnh.param("grid_size_x", h.size_x, h.size_x);
+  pnh.param("grid_size_y", h.size_y, h.size_y);
+  pnh.param("grid_resolution", h.resolution, h.resolution);
+  pnh.param("max_speed", h.max_speed, h.max_speed);
+  pnh.param("p_threshold", h.p_threshold, h.p_threshold);
+  pnh.param("p_min_uwb", h.p_min_uwb, h.p_min_uwb);
+  pnh.param("p_min_cam", h.p_min_cam, h.p_min_cam);
+  pnh.param("p_min_obs", h.p_min_obs, h.p_min_obs);
+  pnh.param("p_min_inov", h.p_min_inov, h.p_min_inov);
+  pnh.param("default_range_sigma", h.default_range_sigma, h.default_range_sigma);
+  pnh.param("bearing_sigma", h.default_bearing_sigma, h.default_bearing_sigma);
+  pnh.param("output_threshold", h.output_threshold, h.output_threshold);
+  pnh.param("max_range", o.max_range, o.max_range);
+  pnh.param("batch_window", o.batch_window, o.batch_window);
+  pnh.param("bearing_max_age", o.bearing_max_age, o.bearing_max_age);
+  pnh.param("pdoa_mode", o.pdoa_mode, o.pdoa_mode);
+  pnh.param("pdoa_angle_sigma", o.pdoa_angle_sigma, o.pdoa_angle_sigma);
+  pnh.param("min_sigma", o.min_sigma, o.min_sigma);
+  pnh.param("cutoff_sigmas", o.cutoff_sigmas, o.cutoff_sigmas);
+  pnh.param("reset_after", o.reset_after, o.reset_after);
+  pnh.param<std::string>("map_frame", map_frame_, "map");
+  pnh.param<std::string>("base_frame", base_frame_, "");
+  pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
+  double map_timeout = 30.0, flush_period = 0.05;
+  pnh.param("map_timeout", map_timeout, map_timeout);
+  pnh.param("flush_period", flush_period, flush_period);
+  map_ = obtainMap(nh, pnh, map_timeout);
+  if (!map_) return;
+  try {
+    uwb_ = std::make_unique<sensors::UwbRanging>(registry, map_, o);
+  } catch (const std::exception& e) {
+    ROS_FATAL("uwb_ranging: %s", e.what());
+    return;
+  }
+  tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
+  std::string topic;
+  pnh.param<std::string>("observation_topic", topic, "/observations");
+  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  std::vector<std::string> uwb_topics{"uwb"}, bearing_topics;
+  pnh.param("uwb_topics", uwb_topics, uwb_topics);
+  pnh.param("bearing_topics", bearing_topics, bearing_topics);
+  for (const std::string& t : uwb_topics) subs_.push_back(nh.subscribe(t, 200, &UwbRangingNode::onRange, this));
+  for (const std::string& t : bearing_topics)
+    subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
+  flush_timer_ = nh.createTimer(ros::Duration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
+  updater_.setHardwareID("uwb_ranging");
+  updater_.add("UWB ranging", this, &UwbRangingNode::diagnose);
+  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  ok_ = true;
+}
+
+std::string UwbRangingNode::baseFrame(const std::string& robot_id) const {
+  if (!base_frame_.empty()) return base_frame_;
+  return robot_id.empty() ? "base_link" : robot_id + "/base_link";
+}
+
+std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, const std::string& frame,
+                                                       const ros::Time& stamp, std::string* error) {
+  const std::string key = base + "|" + frame;
+  auto it = mounts_.find(key);
+  if (it != mounts_.end()) return it->second;
+  // Mounts are static: the latest transform is the one at any stamp.
+  (void)stamp;
+  std::optional<Eigen::Isometry3d> t = lookupTransform(tf_buffer_, base, frame, ros::Time(0), tf_timeout_, error);
+  if (!t) return std::nullopt;
+  const Eigen::Isometry2d m = planar(*t);
+  mounts_[key] = m;
+  return m;
+}
+
+void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
+  const std::string base = baseFrame(msg->robot_id);
+  std::string error;
+  std::optional<Eigen::Isometry2d> anchor = mount(base, msg->header.frame_id, msg->header.stamp, &error);
+  std::optional<Eigen::Isometry3d> robot;
+  if (anchor) robot = lookupTransform(tf_buffer_, map_frame_, base, msg->header.stamp, tf_timeout_, &error);
+  if (!anchor || !robot) {
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "uwb_ranging: range of '%s' from '%s' dropped: no tf at %.3f (%s); %zu dropped so far",
+                      msg->tag_id.c_str(), msg->header.frame_id.c_str(), msg->header.stamp.toSec(), error.c_str(),
+                      tf_failures_);
+    return;
+  }
+  sensors::UwbRangeInput in;
+  in.stamp = msg->header.stamp.toSec();
+  in.robot_id = msg->robot_id;
+  in.tag_id = msg->tag_id;
+  in.anchor_id = msg->header.frame_id;
+  in.anchor_in_robot = *anchor;
+  in.range = msg->range;
+  in.variance = msg->variance;
+  if (msg->has_pdoa) in.pdoa_angle = msg->pdoa_angle;
+  std::vector<core::Observation> out;
+  std::string reason;
+  const sensors::UwbRejection r = uwb_->addRange(in, planar(*robot), &out, &reason);
+  if (r != sensors::UwbRejection::kNone)
+    ROS_WARN_THROTTLE(5.0, "uwb_ranging: range rejected (%s): %s", sensors::toString(r), reason.c_str());
+  publish(out);
+}
+
+void UwbRangingNode::onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
+  std::string error;
+  std::optional<Eigen::Isometry2d> cam = mount(baseFrame(msg->robot_id), msg->header.frame_id, msg->header.stamp, &error);
+  if (!cam) {
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "uwb_ranging: camera detections from '%s' dropped: no tf (%s)",
+                      msg->header.frame_id.c_str(), error.c_str());
+    return;
+  }
+  sensors::CameraBearings set;
+  set.stamp = msg->header.stamp.toSec();
+  const double yaw = std::atan2(cam->linear()(1, 0), cam->linear()(0, 0));
+  for (const auto& d : msg->detections) {
+    if (!std::isfinite(d.bearing)) continue;
+    set.bearings.push_back({cam->translation(), d.bearing + yaw, 0.0});
+  }
+  uwb_->addBearings(set);
+  ++bearing_sets_;
+}
+
+void UwbRangingNode::onFlush(const ros::TimerEvent&) {
+  std::vector<core::Observation> out;
+  uwb_->flush(ros::Time::now().toSec(), &out);
+  publish(out);
+}
+
+void UwbRangingNode::publish(const std::vector<core::Observation>& obs) {
+  for (const core::Observation& o : obs) {
+    pub_.publish(toMsg(o, *map_, map_frame_));
+    ++published_;
+  }
+}
+
+void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const sensors::UwbCounters& c = uwb_->counters();
+  stat.add("received", c.received + tf_failures_);
+  stat.add("accepted", c.accepted);
+  stat.add("dropped: no tf", tf_failures_);
+  stat.add("rejected: unknown tag", c.unknown_tag);
+  stat.add("rejected: not finite", c.not_finite);
+  stat.add("rejected: negative range", c.negative_range);
+  stat.add("rejected: beyond max_range", c.out_of_range);
+  stat.add("rejected: out of order", c.out_of_order);
+  stat.add("RHF updates", c.updates);
+  stat.add("camera detection sets", bearing_sets_);
+  stat.add("published", published_);
+  const std::size_t bad = tf_failures_ + c.unknown_tag + c.not_finite + c.negative_range + c.out_of_range + c.out_of_order;
+  if (c.accepted == 0 && bad > 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no usable UWB ranges yet");
+  else
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu range(s) dropped or rejected", bad);
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation
