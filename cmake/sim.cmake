@@ -11,3 +11,12 @@ add_library(picker_localisation_sim
 target_link_libraries(picker_localisation_sim PUBLIC picker_localisation_core)
 install(TARGETS picker_localisation_sim ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+
+# ROS adapter and the farm_sim node.
+add_library(picker_localisation_sim_ros src/ros/farm_sim_node.cpp)
+target_link_libraries(picker_localisation_sim_ros PUBLIC picker_localisation_ros picker_localisation_sim)
+add_dependencies(picker_localisation_sim_ros ${PROJECT_NAME}_generate_messages_cpp)
+install(TARGETS picker_localisation_sim_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+pl_add_node(farm_sim src/nodes/farm_sim_node.cpp)
+target_link_libraries(farm_sim picker_localisation_sim_ros)

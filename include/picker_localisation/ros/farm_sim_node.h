@@ -1,0 +1,68 @@
+// farm_sim: the farm simulator (picker_localisation::sim::FarmSimulator) as a ROS node. It drives ROS time
+// (/clock, faster than real time by ~rate_factor) and publishes tf, every raw sensor topic and the pickers'
+// ground truth; /<robot>/goal retargets a robot. Parameters and topics: docs/readme/sim.md, config/sim.yaml.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <picker_localisation/GoalNode.h>
+#include <ros/ros.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/sim/farm_simulator.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+class FarmSimNode {
+ public:
+  FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  // False when the configuration could not be loaded (the reason was logged as FATAL).
+  bool ok() const { return static_cast<bool>(sim_); }
+  // Runs until ~duration simulated seconds have passed (0: forever) or ROS shuts down.
+  void run();
+  // One tick: advance the simulation by ~clock_step and publish. Exposed for tests.
+  void tick();
+  double simTime() const { return sim_ ? sim_->time() : 0.0; }
+
+ private:
+  struct RobotIo {
+    ros::Publisher rfid, uwb, camera, truth;
+    std::map<std::string, ros::Publisher> scans;  // by laser frame
+    ros::Subscriber goal;
+  };
+  void publish(const sim::SimOutputs& out);
+  void publishTf(const ros::Time& stamp);
+  void publishStaticFrames();
+  void publishGroundTruth(const ros::Time& stamp);
+  void onGoal(std::size_t robot, const picker_localisation::GoalNode::ConstPtr& msg);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  ros::Time toRos(double sim_t) const { return ros::Time(start_time_ + sim_t); }
+
+  ros::NodeHandle nh_, pnh_;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  std::unique_ptr<sim::FarmSimulator> sim_;
+  core::PickerRegistry registry_;
+  double start_time_ = 100.0, rate_factor_ = 10.0, duration_ = 0.0, clock_step_ = 0.02, truth_rate_ = 10.0;
+  double last_truth_ = -1e9;
+  std::string map_frame_ = "map";
+  ros::Publisher clock_pub_;
+  std::vector<ros::Publisher> fix_pubs_, truth_pubs_;
+  std::vector<RobotIo> robots_;
+  tf2_ros::TransformBroadcaster tf_;
+  tf2_ros::StaticTransformBroadcaster static_tf_;
+  bool publish_sensor_frames_ = true;
+  std::unique_ptr<diagnostic_updater::Updater> diag_;
+  std::size_t n_fix_ = 0, n_scan_ = 0, n_rfid_ = 0, n_uwb_ = 0, n_camera_ = 0, goals_accepted_ = 0,
+              goals_rejected_ = 0;
+  ros::WallTime wall_start_;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

@@ -1,0 +1,336 @@
+#include "picker_localisation/ros/farm_sim_node.h"
+
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <picker_localisation/BearingDetectionArray.h>
+#include <picker_localisation/RfidReading.h>
+#include <picker_localisation/UwbRange.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/NavSatFix.h>
+
+#include <cmath>
+#include <thread>
+
+#include "picker_localisation/ros/map_source.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+namespace {
+
+geometry_msgs::Quaternion yawQuaternion(double yaw) {
+  geometry_msgs::Quaternion q;
+  q.z = std::sin(0.5 * yaw);
+  q.w = std::cos(0.5 * yaw);
+  return q;
+}
+
+geometry_msgs::TransformStamped planarTransform(const ros::Time& stamp, const std::string& parent,
+                                                const std::string& child, const sim::Pose2D& p, double z = 0.0) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  t.transform.translation.x = p.x;
+  t.transform.translation.y = p.y;
+  t.transform.translation.z = z;
+  t.transform.rotation = yawQuaternion(p.yaw);
+  return t;
+}
+
+// laser_front -> scan_front; any other frame name f -> scan_f.
+std::string scanTopicFor(const std::string& frame) {
+  const std::string stem = "laser_";
+  return frame.compare(0, stem.size(), stem) == 0 ? "scan_" + frame.substr(stem.size()) : "scan_" + frame;
+}
+
+template <typename T>
+void overrideParam(ros::NodeHandle& pnh, const std::string& name, T& value) {
+  T v;
+  if (pnh.getParam(name, v)) value = v;
+}
+
+}  // namespace
+
+FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh) {
+  // Configuration: ~sim_config file (config/sim.yaml), then individual parameter overrides.
+  sim::SimConfig config;
+  std::string sim_config, pickers_file, datum_file;
+  pnh_.param<std::string>("sim_config", sim_config, "");
+  pnh_.param<std::string>("pickers_file", pickers_file, "");
+  pnh_.param<std::string>("datum_file", datum_file, "");
+  try {
+    if (!sim_config.empty()) config = sim::loadSimConfig(sim_config);
+    if (!datum_file.empty()) config.datum = sim::loadMapDatum(datum_file);
+    if (!pickers_file.empty()) {
+      registry_ = core::PickerRegistry::load(pickers_file);
+      config.pickers = sim::pickerSpecsFromRegistry(registry_);
+    }
+  } catch (const std::exception& e) {
+    ROS_FATAL("farm_sim: %s", e.what());
+    return;
+  }
+  int seed = static_cast<int>(config.seed), robots = static_cast<int>(config.num_robots);
+  overrideParam(pnh_, "seed", seed);
+  overrideParam(pnh_, "robots", robots);
+  config.seed = static_cast<std::uint64_t>(std::max(0, seed));
+  config.num_robots = static_cast<std::size_t>(std::max(0, robots));
+  overrideParam(pnh_, "robot_speed", config.robot_motion.speed);
+  std::string patrol;
+  if (pnh_.getParam("patrol", patrol)) {
+    try {
+      config.robot_motion.patrol = sim::parsePatrolPolicy(patrol);
+    } catch (const std::exception& e) {
+      ROS_FATAL("farm_sim: ~patrol: %s", e.what());
+      return;
+    }
+  }
+  overrideParam(pnh_, "enable_gnss", config.enable.gnss);
+  overrideParam(pnh_, "enable_laser", config.enable.laser);
+  overrideParam(pnh_, "enable_rfid", config.enable.rfid);
+  overrideParam(pnh_, "enable_uwb", config.enable.uwb);
+  overrideParam(pnh_, "enable_camera", config.enable.camera);
+  pnh_.param("rate_factor", rate_factor_, rate_factor_);
+  pnh_.param("duration", duration_, duration_);
+  pnh_.param("clock_step", clock_step_, clock_step_);
+  pnh_.param("start_time", start_time_, start_time_);
+  pnh_.param("ground_truth_rate", truth_rate_, truth_rate_);
+  pnh_.param("publish_sensor_frames", publish_sensor_frames_, publish_sensor_frames_);
+  pnh_.param<std::string>("map_frame", map_frame_, map_frame_);
+  if (!(clock_step_ > 0.0) || !(start_time_ > 0.0) || !(truth_rate_ > 0.0)) {
+    ROS_FATAL("farm_sim: ~clock_step, ~start_time and ~ground_truth_rate must be > 0");
+    return;
+  }
+
+  map_ = obtainMap(nh_, pnh_);
+  if (!map_) return;
+  try {
+    sim_ = std::make_unique<sim::FarmSimulator>(*map_, config);
+  } catch (const std::exception& e) {
+    ROS_FATAL("farm_sim: %s", e.what());
+    return;
+  }
+
+  clock_pub_ = nh_.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  for (std::size_t i = 0; i < sim_->numPickers(); ++i) {
+    const std::string& id = sim_->pickerSpec(i).id;
+    const core::PickerConfig* pc = registry_.find(id);
+    const std::string topic = pc ? pc->gnss_topic : "/pickers/" + id + "/fix";
+    fix_pubs_.push_back(topic.empty() ? ros::Publisher() : nh_.advertise<sensor_msgs::NavSatFix>(topic, 20));
+    truth_pubs_.push_back(nh_.advertise<geometry_msgs::PoseStamped>("/pickers/" + id + "/ground_truth", 20));
+  }
+  const auto& layout = sim_->config().sensor_layout;
+  for (std::size_t r = 0; r < sim_->numRobots(); ++r) {
+    const std::string ns = "/" + sim_->robot(r).id();
+    RobotIo io;
+    for (const auto& m : layout.lasers)
+      io.scans[m.frame] = nh_.advertise<sensor_msgs::LaserScan>(ns + "/" + scanTopicFor(m.frame), 20);
+    io.rfid = nh_.advertise<picker_localisation::RfidReading>(ns + "/rfid", 100);
+    io.uwb = nh_.advertise<picker_localisation::UwbRange>(ns + "/uwb", 200);
+    io.camera = nh_.advertise<picker_localisation::BearingDetectionArray>(ns + "/camera/detections", 20);
+    io.truth = nh_.advertise<geometry_msgs::PoseStamped>(ns + "/ground_truth", 20);
+    io.goal = nh_.subscribe<picker_localisation::GoalNode>(
+        ns + "/goal", 10, [this, r](const picker_localisation::GoalNode::ConstPtr& m) { onGoal(r, m); });
+    robots_.push_back(std::move(io));
+  }
+  diag_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_);
+  diag_->setHardwareID("farm_sim");
+  diag_->add("simulation", this, &FarmSimNode::diagnose);
+  ROS_INFO("farm_sim: map '%s' (%zu nodes, %zu lanes), %zu pickers, %zu robots, seed %llu, rate factor %.1f, "
+           "duration %.0f s",
+           map_->name().c_str(), map_->numNodes(), sim_->laneLayout().lanes().size(), sim_->numPickers(),
+           sim_->numRobots(), static_cast<unsigned long long>(sim_->config().seed), rate_factor_, duration_);
+}
+
+void FarmSimNode::publishStaticFrames() {
+  if (!publish_sensor_frames_) return;
+  std::vector<geometry_msgs::TransformStamped> frames;
+  const auto& layout = sim_->config().sensor_layout;
+  const ros::Time stamp = toRos(0.0);
+  for (std::size_t r = 0; r < sim_->numRobots(); ++r) {
+    const std::string p = sim_->robot(r).id() + "/";
+    for (const auto* group : {&layout.lasers, &layout.rfid_antennas, &layout.uwb_anchors, &layout.cameras})
+      for (const auto& m : *group) frames.push_back(planarTransform(stamp, p + "base_link", p + m.frame, m.pose, m.z));
+  }
+  static_tf_.sendTransform(frames);
+}
+
+void FarmSimNode::publishTf(const ros::Time& stamp) {
+  std::vector<geometry_msgs::TransformStamped> tfs;
+  for (std::size_t r = 0; r < sim_->numRobots(); ++r) {
+    const std::string p = sim_->robot(r).id() + "/";
+    // Odometry is perfect in the simulator: map -> odom is the identity, odom -> base_link the true pose.
+    tfs.push_back(planarTransform(stamp, map_frame_, p + "odom", sim::Pose2D{}));
+    tfs.push_back(planarTransform(stamp, p + "odom", p + "base_link", sim_->robotPose(r)));
+  }
+  tf_.sendTransform(tfs);
+}
+
+void FarmSimNode::publishGroundTruth(const ros::Time& stamp) {
+  auto poseMsg = [&](const sim::Pose2D& p) {
+    geometry_msgs::PoseStamped m;
+    m.header.stamp = stamp;
+    m.header.frame_id = map_frame_;
+    m.pose.position.x = p.x;
+    m.pose.position.y = p.y;
+    m.pose.orientation = yawQuaternion(p.yaw);
+    return m;
+  };
+  for (std::size_t i = 0; i < sim_->numPickers(); ++i) truth_pubs_[i].publish(poseMsg(sim_->pickerPose(i)));
+  for (std::size_t r = 0; r < sim_->numRobots(); ++r) robots_[r].truth.publish(poseMsg(sim_->robotPose(r)));
+}
+
+void FarmSimNode::publish(const sim::SimOutputs& out) {
+  for (const auto& f : out.gnss) {
+    if (!fix_pubs_[f.picker_index]) continue;
+    sensor_msgs::NavSatFix m;
+    m.header.stamp = toRos(f.stamp);
+    m.header.frame_id = f.picker_id + "/gnss";
+    m.status.status = static_cast<int8_t>(f.status);
+    m.status.service = sensor_msgs::NavSatStatus::SERVICE_GPS;
+    m.latitude = f.latitude;
+    m.longitude = f.longitude;
+    m.altitude = f.altitude;
+    for (std::size_t k = 0; k < 9; ++k) m.position_covariance[k] = f.position_covariance[k];
+    m.position_covariance_type = static_cast<uint8_t>(f.covariance_type);
+    fix_pubs_[f.picker_index].publish(m);
+    ++n_fix_;
+  }
+  for (const auto& s : out.scans) {
+    sensor_msgs::LaserScan m;
+    m.header.stamp = toRos(s.stamp);
+    m.header.frame_id = s.robot_id + "/" + s.frame;
+    m.angle_min = static_cast<float>(s.angle_min);
+    m.angle_max = static_cast<float>(s.angle_max);
+    m.angle_increment = static_cast<float>(s.angle_increment);
+    m.scan_time = static_cast<float>(s.scan_time);
+    m.time_increment = 0.0f;
+    m.range_min = static_cast<float>(s.range_min);
+    m.range_max = static_cast<float>(s.range_max);
+    m.ranges = s.ranges;
+    robots_[s.robot_index].scans[s.frame].publish(m);
+    ++n_scan_;
+  }
+  for (const auto& r : out.rfid) {
+    picker_localisation::RfidReading m;
+    m.header.stamp = toRos(r.stamp);
+    m.header.frame_id = r.robot_id + "/" + r.frame;
+    m.robot_id = r.robot_id;
+    m.tag_id = r.tag_id;
+    m.rssi = r.rssi;
+    m.has_phase = r.has_phase;
+    m.phase = r.phase;
+    robots_[r.robot_index].rfid.publish(m);
+    ++n_rfid_;
+  }
+  for (const auto& u : out.uwb) {
+    picker_localisation::UwbRange m;
+    m.header.stamp = toRos(u.stamp);
+    m.header.frame_id = u.robot_id + "/" + u.frame;
+    m.robot_id = u.robot_id;
+    m.tag_id = u.tag_id;
+    m.range = u.range;
+    m.variance = u.variance;
+    m.has_pdoa = false;
+    robots_[u.robot_index].uwb.publish(m);
+    ++n_uwb_;
+  }
+  for (const auto& c : out.camera) {
+    picker_localisation::BearingDetectionArray m;
+    m.header.stamp = toRos(c.stamp);
+    m.header.frame_id = c.robot_id + "/" + c.frame;
+    m.robot_id = c.robot_id;
+    for (const auto& b : c.boxes) {
+      picker_localisation::BearingDetection d;
+      d.box.x_offset = static_cast<uint32_t>(b.x_offset);
+      d.box.y_offset = static_cast<uint32_t>(b.y_offset);
+      d.box.width = static_cast<uint32_t>(b.width);
+      d.box.height = static_cast<uint32_t>(b.height);
+      d.bearing = b.bearing;
+      d.confidence = b.confidence;
+      m.detections.push_back(d);
+    }
+    robots_[c.robot_index].camera.publish(m);
+    ++n_camera_;
+  }
+}
+
+void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode::ConstPtr& msg) {
+  const std::string& id = sim_->robot(robot).id();
+  if (!msg->robot_id.empty() && msg->robot_id != id) {
+    ++goals_rejected_;
+    ROS_WARN_THROTTLE(5.0, "farm_sim: goal on /%s/goal is for robot '%s'; ignored", id.c_str(), msg->robot_id.c_str());
+    return;
+  }
+  std::optional<topology::NodeIndex> node;
+  if (!msg->node.empty()) {
+    node = map_->index(msg->node);
+  } else if (std::isfinite(msg->pose.position.x) && std::isfinite(msg->pose.position.y)) {
+    node = map_->nearestNode({msg->pose.position.x, msg->pose.position.y});
+  }
+  if (!node) {
+    ++goals_rejected_;
+    ROS_WARN_THROTTLE(5.0, "farm_sim: goal node '%s' for %s is not on the map; ignored", msg->node.c_str(), id.c_str());
+    return;
+  }
+  sim_->setRobotGoal(robot, *node);
+  ++goals_accepted_;
+}
+
+void FarmSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const double wall = (ros::WallTime::now() - wall_start_).toSec();
+  stat.summary(diagnostic_msgs::DiagnosticStatus::OK, goals_rejected_ ? "running (some goals rejected)" : "running");
+  stat.add("simulated time (s)", sim_->time());
+  stat.add("achieved real-time factor", wall > 0 ? sim_->time() / wall : 0.0);
+  stat.add("requested real-time factor", rate_factor_);
+  stat.add("fixes published", n_fix_);
+  stat.add("scans published", n_scan_);
+  stat.add("rfid reads published", n_rfid_);
+  stat.add("uwb ranges published", n_uwb_);
+  stat.add("camera frames published", n_camera_);
+  stat.add("goals accepted", goals_accepted_);
+  stat.add("goals rejected", goals_rejected_);
+}
+
+void FarmSimNode::tick() {
+  const double target = sim_->time() + clock_step_;
+  const sim::SimOutputs out = sim_->advanceTo(duration_ > 0.0 ? std::min(target, duration_) : target);
+  const ros::Time now = toRos(sim_->time());
+  rosgraph_msgs::Clock clock;
+  clock.clock = now;
+  clock_pub_.publish(clock);
+  publishTf(now);
+  if (sim_->time() - last_truth_ >= 1.0 / truth_rate_ - 1e-9) {
+    publishGroundTruth(now);
+    last_truth_ = sim_->time();
+  }
+  publish(out);
+  diag_->update();
+}
+
+void FarmSimNode::run() {
+  if (!ok()) return;
+  wall_start_ = ros::WallTime::now();
+  // Let subscribers connect before time starts moving (wall time: the clock is ours).
+  {
+    rosgraph_msgs::Clock clock;
+    clock.clock = toRos(0.0);
+    clock_pub_.publish(clock);
+  }
+  publishStaticFrames();
+  while (ros::ok() && (duration_ <= 0.0 || sim_->time() < duration_ - 1e-9)) {
+    tick();
+    ros::spinOnce();
+    if (rate_factor_ > 0.0) {
+      const ros::WallTime due = wall_start_ + ros::WallDuration(sim_->time() / rate_factor_);
+      const ros::WallTime now = ros::WallTime::now();
+      if (due > now) (due - now).sleep();
+    }
+  }
+  ROS_INFO("farm_sim: finished at simulated time %.1f s (%.1f s wall)", sim_->time(),
+           (ros::WallTime::now() - wall_start_).toSec());
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation
