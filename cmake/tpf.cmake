@@ -13,3 +13,13 @@ if(benchmark_FOUND)
   set_target_properties(bench_tpf PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
   install(TARGETS bench_tpf RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 endif()
+
+# ROS adapter and the tpf_tracker node (one per picker).
+add_library(picker_localisation_tpf_ros src/ros/tpf_tracker.cpp)
+target_link_libraries(picker_localisation_tpf_ros PUBLIC picker_localisation_ros picker_localisation_tpf)
+add_dependencies(picker_localisation_tpf_ros ${PROJECT_NAME}_generate_messages_cpp)
+install(TARGETS picker_localisation_tpf_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
+  LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
+pl_add_node(tpf_tracker src/nodes/tpf_tracker_node.cpp)
+target_link_libraries(tpf_tracker picker_localisation_tpf_ros)
+catkin_install_python(PROGRAMS scripts/tpf_trackers.py DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})

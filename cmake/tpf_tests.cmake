@@ -1,2 +1,7 @@
 # Topological Particle Filter tests (ROS-free gtests).
 pl_add_gtest(test_tpf test/test_tpf.cpp LIBS picker_localisation_tpf)
+
+# rostest: three trackers started from a pickers file by launch/trackers.launch.
+add_rostest_gtest(test_tpf_tracker test/tpf_tracker.test test/test_tpf_tracker.cpp)
+target_link_libraries(test_tpf_tracker picker_localisation_ros)
+add_dependencies(test_tpf_tracker tpf_tracker)

@@ -1,0 +1,13 @@
+// tpf_tracker: one picker's Topological Particle Filter (see include/picker_localisation/ros/tpf_tracker.h).
+#include <ros/ros.h>
+
+#include "picker_localisation/ros/tpf_tracker.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "tpf_tracker");
+  ros::NodeHandle nh, pnh("~");
+  picker_localisation::ros_adapter::TpfTracker tracker(nh, pnh);
+  if (!tracker.ok()) return 1;
+  ros::spin();
+  return 0;
+}

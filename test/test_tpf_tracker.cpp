@@ -1,0 +1,213 @@
+// rostest of tpf_tracker (three trackers from test/data/tpf_test_pickers.yaml via launch/trackers.launch):
+// beliefs / estimates / markers on observations, another picker's identifying observations ignored,
+// non-identifying ones reaching every tracker, periodic prediction, what-if leaving the live filter alone,
+// reset, and bad input.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <picker_localisation/Observation.h>
+#include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/ResetBelief.h>
+#include <picker_localisation/WhatIf.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/topology/map_io.h"
+
+using namespace picker_localisation;
+
+namespace {
+
+struct PickerTopics {
+  std::vector<PickerBelief> beliefs;
+  std::vector<geometry_msgs::PoseWithCovarianceStamped> estimates;
+  std::vector<visualization_msgs::MarkerArray> markers;
+};
+
+class TrackerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    map_ = std::make_shared<topology::TopologicalMap>(
+        topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
+    pub_ = nh_.advertise<picker_localisation::Observation>("/observations", 50);
+    for (const std::string id : {"picker_1", "picker_2", "picker_3"}) {
+      subs_.push_back(nh_.subscribe<PickerBelief>("/pickers/" + id + "/belief", 50,
+                                                  [this, id](const PickerBelief::ConstPtr& m) { topics_[id].beliefs.push_back(*m); }));
+      subs_.push_back(nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+          "/pickers/" + id + "/estimate", 50,
+          [this, id](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { topics_[id].estimates.push_back(*m); }));
+      subs_.push_back(nh_.subscribe<visualization_msgs::MarkerArray>(
+          "/pickers/" + id + "/markers", 50,
+          [this, id](const visualization_msgs::MarkerArray::ConstPtr& m) { topics_[id].markers.push_back(*m); }));
+      ASSERT_TRUE(ros::service::waitForService("/pickers/" + id + "/what_if", ros::Duration(60.0))) << id;
+    }
+    // Wait until every tracker is subscribed to /observations.
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
+    while (pub_.getNumSubscribers() < 3 && ros::WallTime::now() < until) ros::WallDuration(0.05).sleep();
+    ASSERT_GE(pub_.getNumSubscribers(), 3u);
+    spinFor(0.5);  // latched messages of the start
+  }
+
+  void spinFor(double seconds) {
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::WallTime::now() < until) {
+      ros::spinOnce();
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+  template <typename Pred>
+  bool waitFor(Pred pred, double seconds = 10.0) {
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::WallTime::now() < until) {
+      ros::spinOnce();
+      if (pred()) return true;
+      ros::WallDuration(0.01).sleep();
+    }
+    return pred();
+  }
+
+  // An observation centred on a node (Gaussian likelihood, sigma 1 m).
+  core::Observation observationAt(const std::string& node, const std::string& sensor, const std::string& picker) {
+    core::Observation o;
+    o.stamp = ros::Time::now().toSec();
+    o.sensor = sensor;
+    o.identifying = !picker.empty();
+    o.picker_id = picker;
+    core::setGaussianLikelihood(o, *map_, map_->position2d(*map_->index(node)), Eigen::Matrix2d::Identity());
+    return o;
+  }
+  void send(const core::Observation& o) { pub_.publish(ros_adapter::toMsg(o, *map_)); }
+  int hops(const std::string& a, const std::string& b) { return map_->hopDistance(*map_->index(a), *map_->index(b)); }
+
+  ros::NodeHandle nh_;
+  std::shared_ptr<topology::TopologicalMap> map_;
+  ros::Publisher pub_;
+  std::vector<ros::Subscriber> subs_;
+  std::map<std::string, PickerTopics> topics_;
+};
+
+// Two nodes of different lanes, far apart.
+std::pair<std::string, std::string> farNodes(const topology::TopologicalMap& map) {
+  topology::NodeIndex a = map.laneNodes(0).front();
+  topology::NodeIndex b = a;
+  for (topology::NodeIndex n = 0; n < map.numNodes(); ++n)
+    if (map.hopDistance(a, n) > map.hopDistance(a, b)) b = n;
+  return {map.node(a).name, map.node(b).name};
+}
+
+TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
+  const auto [node_a, node_b] = farNodes(*map_);
+  ASSERT_GT(hops(node_a, node_b), 4);
+
+  // 1. picker_1's GNSS at node A: belief, estimate and markers of picker_1 near A.
+  for (int k = 0; k < 3; ++k) {
+    send(observationAt(node_a, "gnss", "picker_1"));
+    spinFor(0.2);
+  }
+  ASSERT_TRUE(waitFor([&] { return topics_["picker_1"].beliefs.size() >= 3; }));
+  const PickerBelief b1 = topics_["picker_1"].beliefs.back();
+  EXPECT_EQ(b1.picker_id, "picker_1");
+  EXPECT_LE(hops(b1.estimated_node, node_a), 1);
+  EXPECT_EQ(b1.particle_count, 500u);  // per-picker override from the pickers file
+  EXPECT_EQ(b1.nodes.size(), b1.masses.size());
+  double total = 0.0;
+  for (double m : b1.masses) total += m;
+  EXPECT_NEAR(total, 1.0, 1e-6);
+  EXPECT_EQ(b1.header.frame_id, "map");
+  ASSERT_FALSE(topics_["picker_1"].estimates.empty());
+  const auto& est = topics_["picker_1"].estimates.back().pose.pose.position;
+  EXPECT_NEAR(est.x, map_->node(*map_->index(b1.estimated_node)).position.x(), 1e-9);
+  ASSERT_FALSE(topics_["picker_1"].markers.empty());
+  ASSERT_FALSE(topics_["picker_1"].markers.back().markers.empty());
+  EXPECT_EQ(topics_["picker_1"].markers.back().markers[0].points.size(), b1.nodes.size());
+  // picker_2 and picker_3 got nothing identifying: no belief beyond the latched start-up one.
+  for (const auto& b : topics_["picker_2"].beliefs) EXPECT_EQ(b.observations, 0u);
+
+  // 2. picker_2's identifying GNSS at node B never reaches picker_1.
+  const std::size_t p1_count = topics_["picker_1"].beliefs.size();
+  send(observationAt(node_b, "gnss", "picker_2"));
+  ASSERT_TRUE(waitFor([&] { return !topics_["picker_2"].beliefs.empty() && topics_["picker_2"].beliefs.back().observations == 1; }));
+  EXPECT_LE(hops(topics_["picker_2"].beliefs.back().estimated_node, node_b), 1);
+  spinFor(0.2);
+  for (std::size_t k = p1_count; k < topics_["picker_1"].beliefs.size(); ++k)
+    EXPECT_EQ(topics_["picker_1"].beliefs[k].observations, b1.observations) << "picker_1 fused picker_2's fix";
+
+  // 3. A non-identifying LiDAR detection at A reaches every tracker (picker_3 initialises from it).
+  send(observationAt(node_a, "lidar", ""));
+  ASSERT_TRUE(waitFor([&] {
+    return !topics_["picker_3"].beliefs.empty() && topics_["picker_3"].beliefs.back().observations == 1 &&
+           topics_["picker_1"].beliefs.back().observations == b1.observations + 1;
+  }));
+
+  // 4. Periodic prediction (picker_1 at 2 Hz) without observations: newer stamps, same observation count.
+  const double last_stamp = topics_["picker_1"].beliefs.back().header.stamp.toSec();
+  ASSERT_TRUE(waitFor([&] { return topics_["picker_1"].beliefs.back().header.stamp.toSec() > last_stamp + 0.4; }, 5.0));
+  EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, b1.observations + 1);
+
+  // 5. What-if: predict ahead, and posterior under a hypothetical observation at B; the live filter stays.
+  ros::ServiceClient what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/picker_1/what_if");
+  picker_localisation::WhatIf ahead;
+  ahead.request.horizon = 4.0;
+  ahead.request.seed = 7;
+  ASSERT_TRUE(what_if.call(ahead));
+  ASSERT_TRUE(ahead.response.success) << ahead.response.message;
+  picker_localisation::WhatIf hyp;
+  hyp.request.horizon = 1.0;
+  hyp.request.with_observation = true;
+  hyp.request.observation = ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
+  hyp.request.seed = 7;
+  ASSERT_TRUE(what_if.call(hyp));
+  ASSERT_TRUE(hyp.response.success) << hyp.response.message;
+  EXPECT_LE(hops(hyp.response.belief.estimated_node, node_b), 1);
+  picker_localisation::WhatIf now;  // horizon 0: the live belief
+  ASSERT_TRUE(what_if.call(now));
+  EXPECT_LE(hops(now.response.belief.estimated_node, node_a), 1);
+  EXPECT_EQ(now.response.belief.observations, b1.observations + 1);
+  picker_localisation::WhatIf bad_horizon;
+  bad_horizon.request.horizon = -1.0;
+  ASSERT_TRUE(what_if.call(bad_horizon));
+  EXPECT_FALSE(bad_horizon.response.success);
+
+  // 6. Bad input: NaN likelihood, unknown node names, a stale stamp: rejected, tracker alive, belief kept.
+  picker_localisation::Observation bad = ros_adapter::toMsg(observationAt(node_a, "gnss", "picker_1"), *map_);
+  bad.likelihood[0] = std::nan("");
+  pub_.publish(bad);
+  picker_localisation::Observation unknown = ros_adapter::toMsg(observationAt(node_a, "gnss", "picker_1"), *map_);
+  for (auto& n : unknown.nodes) n = "no_such_node_" + n;
+  pub_.publish(unknown);
+  picker_localisation::Observation stale = ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
+  stale.header.stamp = ros::Time(1.0);
+  pub_.publish(stale);
+  spinFor(0.5);
+  picker_localisation::WhatIf after;
+  ASSERT_TRUE(what_if.call(after));
+  EXPECT_EQ(after.response.belief.observations, b1.observations + 1);
+  EXPECT_LE(hops(after.response.belief.estimated_node, node_a), 1);
+
+  // 7. Reset: the belief is forgotten; the next observation initialises it again.
+  ros::ServiceClient reset = nh_.serviceClient<picker_localisation::ResetBelief>("/pickers/picker_1/reset");
+  picker_localisation::ResetBelief r;
+  ASSERT_TRUE(reset.call(r));
+  EXPECT_TRUE(r.response.success);
+  picker_localisation::WhatIf empty;
+  ASSERT_TRUE(what_if.call(empty));
+  EXPECT_FALSE(empty.response.success);
+  EXPECT_EQ(empty.response.belief.particle_count, 0u);
+  send(observationAt(node_b, "gnss", "picker_1"));
+  ASSERT_TRUE(waitFor([&] { return topics_["picker_1"].beliefs.back().observations == 1; }));
+  EXPECT_LE(hops(topics_["picker_1"].beliefs.back().estimated_node, node_b), 1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_tpf_tracker");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
