@@ -11,6 +11,7 @@
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
 #ifdef PL_TEST_HAVE_SIM
+#include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/sim/farm_simulator.h"
 #endif
 
@@ -149,15 +150,15 @@ TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
   ASSERT_FALSE(r.samples.empty());
   // The truth of a sample is the simulator's picker pose at that time (same seed; the pickers do not depend on
   // the sensors switched on).
-  sim::SimConfig sc;
+  // the configuration the runner (and farm_sim in demo.launch) uses: config/sim.yaml + config/pickers.yaml
+  const std::string sim_file = resolveConfigFile("", "sim.yaml");
+  sim::SimConfig sc = sim_file.empty() ? sim::SimConfig() : sim::loadSimConfig(sim_file);
   sc.seed = 5;
-  for (int i = 1; i <= 3; ++i) {
-    sim::PickerSpec p;
-    p.id = "picker_" + std::to_string(i);
-    p.rfid_tag = "rfid_000" + std::to_string(i);
-    p.uwb_tag = "uwb_000" + std::to_string(i);
-    sc.pickers.push_back(p);
-  }
+  sc.num_robots = 1;
+  const std::string pickers_file = resolveConfigFile("", "pickers.yaml");
+  ASSERT_FALSE(pickers_file.empty());
+  sc.pickers = sim::pickerSpecsFromRegistry(core::PickerRegistry::load(pickers_file));
+  sc.pickers.resize(3);
   sim::FarmSimulator simulator(*map, sc);
   std::size_t checked = 0;
   for (const auto& s : r.samples) {

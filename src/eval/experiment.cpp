@@ -111,6 +111,13 @@ std::size_t numPickers(Scenario s) { return s == Scenario::kMulti ? 3 : 1; }
 
 }  // namespace
 
+std::string resolveConfigFile(const std::string& value, const std::string& package_file) {
+  if (value == "none") return "";
+  if (!value.empty()) return value;
+  const std::string p = std::string(PL_EVAL_PACKAGE_DIR) + "/config/" + package_file;
+  return fs::exists(p) ? p : "";
+}
+
 const std::vector<std::string>& allMethodNames() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> n;
@@ -218,18 +225,32 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   const MethodSpec& spec = specOf(config.method);
   RunResult result;
 
-  // --- simulator ---------------------------------------------------------------------------------------
-  sim::SimConfig sc;
+  // --- simulator: the ROS graph's configuration files, then the scenario --------------------------------
+  const std::string sim_file = resolveConfigFile(config.sim_config, "sim.yaml");
+  const std::string datum_file = resolveConfigFile(config.datum_file, "datum.yaml");
+  const std::string pickers_file = resolveConfigFile(config.pickers_file, "pickers.yaml");
+  sim::SimConfig sc = sim_file.empty() ? sim::SimConfig() : sim::loadSimConfig(sim_file);
+  if (!datum_file.empty()) sc.datum = sim::loadMapDatum(datum_file);
   sc.seed = config.seed;
   const std::size_t n = numPickers(config.scenario);
-  for (std::size_t i = 0; i < n; ++i) {
-    sim::PickerSpec p;
-    p.id = "picker_" + std::to_string(i + 1);
-    p.rfid_tag = "rfid_000" + std::to_string(i + 1);
-    p.uwb_tag = "uwb_000" + std::to_string(i + 1);
-    sc.pickers.push_back(p);
+  sc.pickers.clear();
+  if (!pickers_file.empty()) {
+    const auto specs = sim::pickerSpecsFromRegistry(core::PickerRegistry::load(pickers_file));
+    if (specs.size() < n)
+      throw std::runtime_error(pickers_file + ": scenario " + toString(config.scenario) + " needs " +
+                               std::to_string(n) + " pickers");
+    sc.pickers.assign(specs.begin(), specs.begin() + static_cast<long>(n));
+  } else {
+    for (std::size_t i = 0; i < n; ++i) {
+      sim::PickerSpec p;
+      p.id = "picker_" + std::to_string(i + 1);
+      p.rfid_tag = "rfid_000" + std::to_string(i + 1);
+      p.uwb_tag = "uwb_000" + std::to_string(i + 1);
+      sc.pickers.push_back(p);
+    }
   }
   sc.num_robots = 1;
+  sc.robot_ids.clear();
   sc.robot_motion.patrol = sim::PatrolPolicy::kLanes;
   // Sensors a method does not use are switched off (the simulator guarantees that this does not change the
   // pickers' walks or GNSS errors, so every method of a seed sees the same pickers).
@@ -240,8 +261,9 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   sc.enable.camera = false;
   sim::FarmSimulator simulator(*map, sc);
 
-  // --- front-ends --------------------------------------------------------------------------------------
-  const sensors::GeodeticDatum datum = datumOf(simulator.projection().datum());
+  // --- front-ends (GnssIngest uses the datum file as the gnss_ingest node does) ---------------------------
+  const sensors::GeodeticDatum datum =
+      datum_file.empty() ? datumOf(simulator.projection().datum()) : sensors::GeodeticDatum::load(datum_file);
   std::vector<PickerTrack> tracks(n);
   std::vector<core::PickerConfig> registry_entries;
   for (std::size_t i = 0; i < n; ++i) {
@@ -266,12 +288,13 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
 #ifdef PL_HAVE_TPF
   double prediction_period = 4.0;
   if (spec.tracker == Tracker::kTpf) {
-    tpf::TpfParams base = config.tpf_config.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(config.tpf_config);
+    const std::string tpf_file = resolveConfigFile(config.tpf_config, "tpf.yaml");
+    tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
     const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
     prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
     for (std::size_t i = 0; i < n; ++i)
       tracks[i].tpf = std::make_unique<tpf::TopologicalParticleFilter>(map, params,
-                                                                       sim::deriveSeed(config.seed, 1000 + i));
+                                                                       sim::deriveSeed(config.tracker_seed ? config.tracker_seed : config.seed, 1000 + i));
   }
 #endif
   auto toTracker = [&](const core::Observation& obs) {

@@ -49,7 +49,7 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
   timer_ = nh.createTimer(ros::Duration(1.0 / sample_rate), &Evaluator::onTimer, this);
   ROS_INFO("evaluator: %zu pickers, map '%s', sampling at %g Hz%s", pickers_.size(), map_->name().c_str(),
-           sample_rate, duration_ > 0.0 ? (", stopping at t = " + std::to_string(duration_) + " s").c_str() : "");
+           sample_rate, duration_ > 0.0 ? (", stopping " + std::to_string(duration_) + " s after the first ground truth").c_str() : "");
   ok_ = true;
 }
 
@@ -76,6 +76,7 @@ void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPt
     return;
   }
   p.truth = t;
+  if (first_truth_ < 0.0) first_truth_ = msg->header.stamp.isZero() ? ros::Time::now().toSec() : msg->header.stamp.toSec();
 }
 
 void Evaluator::onTimer(const ros::TimerEvent& ev) {
@@ -97,7 +98,7 @@ void Evaluator::onTimer(const ros::TimerEvent& ev) {
     p.error_pub.publish(msg);
   }
   diagnostics_.update();
-  if (duration_ > 0.0 && now.toSec() >= duration_) {
+  if (duration_ > 0.0 && first_truth_ >= 0.0 && now.toSec() >= first_truth_ + duration_) {
     done_ = true;
     finish();
     ros::shutdown();

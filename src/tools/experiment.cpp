@@ -1,6 +1,7 @@
 // experiment: the offline Table II runner (in-process, deterministic, no roscore).
 //   experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N] [--seed S]
 //              [--duration SEC] --out DIR [--jobs J] [--sample-period SEC] [--leg-model FILE] [--tpf-config FILE]
+//              [--sim-config FILE] [--datum FILE] [--pickers FILE] [--tracker-seed N]
 // Exit status: 0 success, 2 bad arguments / map / output directory.
 #include <cstdlib>
 #include <iostream>
@@ -15,10 +16,12 @@ namespace {
 void usage(std::ostream& o) {
   o << "usage: experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N]\n"
        "                  [--seed S] [--duration SEC] --out DIR [--jobs J] [--sample-period SEC]\n"
-       "                  [--leg-model FILE] [--tpf-config FILE]\n"
+       "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
+       "                  [--pickers FILE] [--tracker-seed N]\n"
+       "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in defaults\n"
        "methods:";
   for (const auto& m : picker_localisation::eval::allMethodNames()) o << ' ' << m;
-  o << "\ndefaults: methods = the scenario's Table II rows, runs 10, seed 1, duration 300 s, jobs 1\n";
+  o << "\ndefaults: methods = the scenario's Table II rows, runs 10, seed 1, duration 600 s, jobs 1\n";
 }
 
 std::vector<std::string> splitComma(const std::string& s) {
@@ -56,6 +59,10 @@ int main(int argc, char** argv) {
       else if (a == "--sample-period") cfg.run.sample_period = std::stod(v);
       else if (a == "--leg-model") cfg.run.leg_model = v;
       else if (a == "--tpf-config") cfg.run.tpf_config = v;
+      else if (a == "--sim-config") cfg.run.sim_config = v;
+      else if (a == "--datum") cfg.run.datum_file = v;
+      else if (a == "--pickers") cfg.run.pickers_file = v;
+      else if (a == "--tracker-seed") cfg.run.tracker_seed = std::stoull(v);
       else throw std::invalid_argument("unknown option " + a);
     }
     if (cfg.map_path.empty() || scenario.empty() || cfg.out_dir.empty())

@@ -40,14 +40,24 @@ struct RunConfig {
   Scenario scenario = Scenario::kSingle;
   std::string method = "rfid_lidar_gnss";
   std::uint64_t seed = 1;          // simulator seed of this run; trackers derive theirs from it
-  double duration = 300.0;         // simulated s
+  double duration = 600.0;         // simulated s (one tour of the Riseholme lanes at 0.5 m/s)
   double sample_period = 1.0;      // s between metric samples (per picker)
   double step = 0.1;               // s, simulator advance between event merges
   double lidar_sigma = 0.3;        // m, std of the Gaussian node likelihood of a leg detection
   double replan_period = 10.0;     // s, navigation policies re-plan at least this often
-  std::string leg_model;           // leg classifier model file (OpenCV YAML); "" = package default
-  std::string tpf_config;          // config/tpf.yaml to start from ("" = Table I defaults)
+  // Configuration files shared with the ROS graph (farm_sim, gnss_ingest, tpf_tracker, ...), so the runner
+  // and demo.launch simulate the same farm. "" = the package's config/<file> when it exists, else built-in
+  // defaults; "none" = built-in defaults.
+  std::string leg_model;           // leg classifier model (OpenCV YAML), config/leg_classifier.yml
+  std::string tpf_config;          // TPF parameters, config/tpf.yaml (the method preset is applied on top)
+  std::string sim_config;          // simulator, config/sim.yaml (seed, pickers, robots, switches set here)
+  std::string datum_file;          // geodetic datum of simulator and GnssIngest, config/datum.yaml
+  std::string pickers_file;        // pickers (the first 1 or 3 entries), config/pickers.yaml
+  std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
 };
+
+// The file a RunConfig field resolves to ("" = built-in defaults): see RunConfig.
+std::string resolveConfigFile(const std::string& value, const std::string& package_file);
 
 // "" when `method` can run in this build, else one line saying what is missing.
 std::string methodUnavailableReason(const std::string& method, const RunConfig& config = RunConfig());
@@ -68,7 +78,7 @@ struct ExperimentConfig {
   std::vector<std::string> methods;  // empty: defaultMethods(scenario)
   std::size_t runs = 10;
   std::uint64_t seed = 1;            // run k (0-based) uses seed + k, the same for every method
-  double duration = 300.0;
+  double duration = 600.0;
   std::string out_dir;
   std::size_t jobs = 1;              // runs executed in parallel (results do not depend on it)
   RunConfig run;                     // template for the per-run options (scenario/method/seed/duration set here)

@@ -3,8 +3,8 @@
 //   subscribes  /pickers/<id>/belief (picker_localisation/PickerBelief), /pickers/<id>/ground_truth
 //               (geometry_msgs/PoseStamped) for every picker of ~pickers_file; the map as ros_adapter::obtainMap
 //   publishes   /pickers/<id>/error (picker_localisation/TrackingError), /diagnostics
-//   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; ROS time s after
-//               which the table is printed and the node exits), ~output_csv ("" none: per-sample CSV at exit)
+//   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; s of ROS time after
+//               the first ground truth, then the table is printed and the node exits: end it with required="true"), ~output_csv ("" none: per-sample CSV at exit)
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -52,6 +52,7 @@ class Evaluator {
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::vector<Picker> pickers_;
   double duration_ = 0.0;
+  double first_truth_ = -1.0;  // ROS time of the first ground truth, s
   std::string output_csv_;
   ros::Timer timer_;
   diagnostic_updater::Updater diagnostics_;
