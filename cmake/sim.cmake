@@ -20,3 +20,12 @@ install(TARGETS picker_localisation_sim_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 pl_add_node(farm_sim src/nodes/farm_sim_node.cpp)
 target_link_libraries(farm_sim picker_localisation_sim_ros)
+
+# bench_sim: simulated seconds per wall second.
+if(benchmark_FOUND)
+  add_executable(bench_sim src/tools/bench_sim.cpp)
+  target_link_libraries(bench_sim picker_localisation_sim benchmark::benchmark)
+  target_compile_definitions(bench_sim PRIVATE PL_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
+  set_target_properties(bench_sim PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+  install(TARGETS bench_sim RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+endif()

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
@@ -440,6 +441,67 @@ TEST(LaserModel, RayHitsALegCircleAtTheAnalyticRange) {
   const Pose2D moved{5.0, -2.0, M_PI / 2};
   const LaserScan s2 = castLaser(scene, moved, params, 1.0, rng);
   EXPECT_NEAR(s2.ranges[beam(0.0)], 2.0 - 0.06, 1e-5);
+}
+
+TEST(LaserModel, BeamWindowsMatchTestingEveryBeam) {
+  // The ray cast only tests the beams inside each obstacle's angular extent; it must equal testing every beam
+  // against every obstacle, for random scenes and sensor poses (including wrap-around at +-pi).
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(-8.0, 8.0), ang(-M_PI, M_PI), rad(0.02, 0.5);
+  LaserParams params;
+  params.range_noise_std = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    LaserScene scene;
+    for (int k = 0; k < 30; ++k) scene.circles.push_back({{u(rng), u(rng)}, rad(rng)});
+    for (int k = 0; k < 6; ++k) scene.segments.push_back({{u(rng), u(rng)}, {u(rng), u(rng)}});
+    if (trial % 2) {
+      params.angle_min = -M_PI;
+      params.angle_max = M_PI;
+    } else {
+      params.angle_min = -2.356194;
+      params.angle_max = 2.356194;
+    }
+    const Pose2D pose{u(rng) * 0.2, u(rng) * 0.2, ang(rng)};
+    const LaserScan scan = castLaser(scene, pose, params, 0.0, rng);
+    for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+      const double a = pose.yaw + scan.angle_min + i * scan.angle_increment;
+      const Eigen::Vector2d d(std::cos(a), std::sin(a));
+      double r = std::numeric_limits<double>::infinity();
+      for (const auto& c : scene.circles) r = std::min(r, rayCircle(pose.position(), d, c));
+      for (const auto& sg : scene.segments) r = std::min(r, raySegment(pose.position(), d, sg));
+      if (r < params.range_min) continue;  // -inf (too close) or inside a circle
+      if (std::isinf(r)) EXPECT_TRUE(std::isinf(scan.ranges[i])) << trial << " " << i;
+      else EXPECT_NEAR(scan.ranges[i], r, 1e-4) << trial << " " << i;
+    }
+  }
+}
+
+TEST(LaserModel, OtherRobotsAreObstacles) {
+  // Two robots side by side in adjacent lanes: each one's lasers see the other's footprint.
+  const auto map = polytunnel(4, 10);
+  LaneLayout layout(map);
+  SimConfig c = quietConfig();
+  c.num_robots = 2;
+  c.robot_start_nodes = {map.node(layout.lanes()[1].nodes[4]).name, map.node(layout.lanes()[2].nodes[4]).name};
+  c.robot_motion.patrol = PatrolPolicy::kStay;
+  c.clutter.bed_posts = false;
+  c.laser.range_noise_std = 0.0;
+  c.pickers = {{"p", true, "", "", 0}};
+  FarmSimulator sim(map, c);
+  const auto out = sim.step(0.1);
+  int hits_on_other = 0;
+  const double hl = 0.75, hw = 0.7;
+  for (const auto& scan : out.scans) {
+    const Pose2D other = sim.robotPose(1 - scan.robot_index);
+    for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
+      if (!std::isfinite(scan.ranges[b])) continue;
+      const double a = scan.sensor_pose.yaw + scan.angle_min + b * scan.angle_increment;
+      const Eigen::Vector2d hit = scan.sensor_pose.position() + scan.ranges[b] * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const Eigen::Vector2d local = other.inverseTransform(hit);
+      if (std::abs(std::abs(local.x()) - hl) < 1e-3 || std::abs(std::abs(local.y()) - hw) < 1e-3) ++hits_on_other;
+    }
+  }
+  EXPECT_GT(hits_on_other, 20);
 }
 
 TEST(LaserModel, RangeNoiseStd) {

@@ -50,36 +50,41 @@ LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const La
   scan.ranges.assign(static_cast<std::size_t>(n), std::numeric_limits<float>::infinity());
   const Eigen::Vector2d o = sensor_pose.position();
   std::vector<double> best(static_cast<std::size_t>(n), kInf);
-  auto beamDir = [&](int i) {
+  std::vector<Eigen::Vector2d> dirs(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
     const double ang = sensor_pose.yaw + params.angle_min + i * params.angle_increment;
-    return Eigen::Vector2d(std::cos(ang), std::sin(ang));
+    dirs[static_cast<std::size_t>(i)] = Eigen::Vector2d(std::cos(ang), std::sin(ang));
+  }
+  // Tests the beams whose angle (relative to the sensor) lies in [lo, hi] (rad, any branch of the angle).
+  auto castWindow = [&](double lo, double hi, auto&& hit) {
+    for (double shift : {-2.0 * M_PI, 0.0, 2.0 * M_PI}) {
+      const int i0 = std::max(0, static_cast<int>(std::ceil((lo + shift - params.angle_min) / params.angle_increment)));
+      const int i1 = std::min(n - 1, static_cast<int>(std::floor((hi + shift - params.angle_min) / params.angle_increment)));
+      for (int i = i0; i <= i1; ++i) {
+        const double r = hit(dirs[static_cast<std::size_t>(i)]);
+        if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
+      }
+    }
   };
-  // Circles: only the beams inside each circle's angular extent are tested.
+  auto relAngle = [&](const Eigen::Vector2d& v) { return std::remainder(std::atan2(v.y(), v.x()) - sensor_pose.yaw, 2.0 * M_PI); };
   const double reach = params.range_max + 1.0;
+  // Circles: only the beams inside each circle's angular extent.
   for (const auto& c : scene.circles) {
     const Eigen::Vector2d v = c.centre - o;
     const double d = v.norm();
     if (d - c.radius > reach || d <= c.radius) continue;
     const double half = std::asin(std::min(1.0, c.radius / d));
-    const double rel = std::remainder(std::atan2(v.y(), v.x()) - sensor_pose.yaw, 2.0 * M_PI);
-    for (double shift : {-2.0 * M_PI, 0.0, 2.0 * M_PI}) {
-      const double lo = (rel + shift - half - params.angle_min) / params.angle_increment;
-      const double hi = (rel + shift + half - params.angle_min) / params.angle_increment;
-      const int i0 = std::max(0, static_cast<int>(std::ceil(lo)));
-      const int i1 = std::min(n - 1, static_cast<int>(std::floor(hi)));
-      for (int i = i0; i <= i1; ++i) {
-        const double r = rayCircle(o, beamDir(i), c);
-        if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
-      }
-    }
+    const double rel = relAngle(v);
+    castWindow(rel - half, rel + half, [&](const Eigen::Vector2d& dir) { return rayCircle(o, dir, c); });
   }
-  // Segments (few: other robots' footprints): every beam.
+  // Segments: the beams between the angles of the two endpoints (a segment off the origin subtends < pi).
   for (const auto& sg : scene.segments) {
     if (std::min((sg.a - o).norm(), (sg.b - o).norm()) > reach + (sg.b - sg.a).norm()) continue;
-    for (int i = 0; i < n; ++i) {
-      const double r = raySegment(o, beamDir(i), sg);
-      if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
-    }
+    const double a1 = relAngle(sg.a - o);
+    const double span = std::remainder(relAngle(sg.b - o) - a1, 2.0 * M_PI);
+    const double margin = 1e-9;
+    castWindow(std::min(a1, a1 + span) - margin, std::max(a1, a1 + span) + margin,
+               [&](const Eigen::Vector2d& dir) { return raySegment(o, dir, sg); });
   }
   std::normal_distribution<double> noise(0.0, params.range_noise_std);
   for (int i = 0; i < n; ++i) {
