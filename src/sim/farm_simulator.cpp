@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 #include <unordered_map>
 
 namespace picker_localisation {
@@ -273,45 +274,39 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
       }
     }
   });
-  onTicks(rfid_tick_, config_.rfid.rate, time_, [&](double stamp) {
-    if (!en.rfid) return;
+  // RFID and UWB: one attempt per robot, mount and tagged picker; `simulate` fills the model's fields.
+  auto tagSensor = [&](double stamp, const std::vector<SensorMount2D>& mounts, const std::string PickerSpec::*tag,
+                       double tag_height, std::mt19937_64 SensorStreams::*stream, auto& readings, auto&& simulate) {
+    using Reading = typename std::decay_t<decltype(readings)>::value_type;
     for (std::size_t r = 0; r < robots_.size(); ++r)
-      for (const auto& m : layout.rfid_antennas) {
+      for (const auto& m : mounts) {
         const Eigen::Vector2d a = robots_[r].pose().compose(m.pose).position();
         for (std::size_t i = 0; i < pickers_.size(); ++i) {
-          if (config_.pickers[i].rfid_tag.empty()) continue;
-          RfidRead read;
-          const double d = distance3d(a, m.z, pickers_[i].pose().position(), config_.rfid.tag_height);
-          if (!simulateRfidRead(config_.rfid, d, streams_[r]->rfid, read)) continue;
-          read.stamp = stamp;
-          read.robot_id = robots_[r].id();
-          read.robot_index = r;
-          read.frame = m.frame;
-          read.tag_id = config_.pickers[i].rfid_tag;
-          read.picker_index = i;
-          out.rfid.push_back(std::move(read));
+          if ((config_.pickers[i].*tag).empty()) continue;
+          Reading reading;
+          const double d = distance3d(a, m.z, pickers_[i].pose().position(), tag_height);
+          if (!simulate(d, (*streams_[r]).*stream, reading)) continue;
+          reading.stamp = stamp;
+          reading.robot_id = robots_[r].id();
+          reading.robot_index = r;
+          reading.frame = m.frame;
+          reading.tag_id = config_.pickers[i].*tag;
+          reading.picker_index = i;
+          readings.push_back(std::move(reading));
         }
       }
+  };
+  onTicks(rfid_tick_, config_.rfid.rate, time_, [&](double stamp) {
+    if (!en.rfid) return;
+    tagSensor(stamp, layout.rfid_antennas, &PickerSpec::rfid_tag, config_.rfid.tag_height, &SensorStreams::rfid,
+              out.rfid, [&](double d, std::mt19937_64& rng, RfidRead& read) {
+                return simulateRfidRead(config_.rfid, d, rng, read);
+              });
   });
   onTicks(uwb_tick_, config_.uwb.rate, time_, [&](double stamp) {
     if (!en.uwb) return;
-    for (std::size_t r = 0; r < robots_.size(); ++r)
-      for (const auto& m : layout.uwb_anchors) {
-        const Eigen::Vector2d a = robots_[r].pose().compose(m.pose).position();
-        for (std::size_t i = 0; i < pickers_.size(); ++i) {
-          if (config_.pickers[i].uwb_tag.empty()) continue;
-          UwbReading u;
-          const double d = distance3d(a, m.z, pickers_[i].pose().position(), config_.uwb.tag_height);
-          if (!simulateUwbRange(config_.uwb, d, streams_[r]->uwb, u)) continue;
-          u.stamp = stamp;
-          u.robot_id = robots_[r].id();
-          u.robot_index = r;
-          u.frame = m.frame;
-          u.tag_id = config_.pickers[i].uwb_tag;
-          u.picker_index = i;
-          out.uwb.push_back(std::move(u));
-        }
-      }
+    tagSensor(stamp, layout.uwb_anchors, &PickerSpec::uwb_tag, config_.uwb.tag_height, &SensorStreams::uwb, out.uwb,
+              [&](double d, std::mt19937_64& rng, UwbReading& u) { return simulateUwbRange(config_.uwb, d, rng, u); });
   });
   onTicks(camera_tick_, config_.camera.rate, time_, [&](double stamp) {
     if (!en.camera) return;
