@@ -166,6 +166,35 @@ TEST(TpfEquations, PredictionJumpsAtTheEq2Rate) {
   }
 }
 
+TEST(TpfEquations, JumpsDoNotDependOnThePredictionRate) {
+  // Step consistent (default): one 3 s step and thirty 0.1 s steps both leave half the particles at node 3
+  // (Eq. 2 = 1/2 at the half-edge dwell). Literal: Eq. 2 afresh at every step moves far more of them.
+  auto map = laneMap();
+  auto fraction_moved = [&](bool consistent, int steps) {
+    TpfParams p = staticParams(20000);
+    p.velocity_init_mean = 0.5;
+    p.dwell_init_max = 0.0;
+    p.step_consistent_jumps = consistent;
+    TopologicalParticleFilter f(map, p, 7);
+    EXPECT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
+    for (int k = 1; k <= steps; ++k) f.predictTo(3.0 * k / steps);
+    double moved = 0.0;
+    for (const auto& q : f.particles()) moved += q.node != 2 ? 1.0 : 0.0;
+    return moved / 20000.0;
+  };
+  EXPECT_NEAR(fraction_moved(true, 1), 0.5, 0.015);
+  EXPECT_NEAR(fraction_moved(true, 30), 0.5, 0.015);
+  EXPECT_NEAR(fraction_moved(false, 1), 0.5, 0.015);
+  EXPECT_GT(fraction_moved(false, 30), 0.8);
+  // A step with dt = 0 (e.g. a late observation fused at the current time) never jumps.
+  TpfParams p = staticParams(1000);
+  p.velocity_init_mean = 0.5;
+  TopologicalParticleFilter f(map, p, 3);
+  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
+  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
+  for (const auto& q : f.particles()) EXPECT_EQ(q.node, 2u);
+}
+
 // --------------------------------------------------------------------------------------------- Eq. 8 ------
 TEST(TpfEquations, Eq8WeightPerSensor) {
   auto map = laneMap();

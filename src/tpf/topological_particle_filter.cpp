@@ -18,10 +18,11 @@ constexpr double kMinEdgeLength = 1e-6;                // m; shorter edges have 
 inline double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
 // Standard normal variates for the resampling noise of Eq. 12 by inverse-transform sampling on a grid:
-// entry i is the quantile Phi^-1((i + 1/2) / 65536), so 16 random bits give one N(0, 1) draw (tails cut at
-// 4.3 sigma, variance 0.9997). One 64-bit draw then serves two velocity components and the dwell noise, which
-// keeps the noise at a few ns per particle instead of ~25 ns with std::normal_distribution.
-constexpr int kNormalTableBits = 16;
+// entry i is the quantile Phi^-1((i + 1/2) / 4096), so 12 random bits give one N(0, 1) draw (tails cut at
+// 3.6 sigma, variance 0.997). The 32 spare bits of each particle's prediction draw then serve both velocity
+// components (12 + 12 bits) and the dwell noise (8 bits: 256 levels over [tau^-, tau^+]), which keeps the
+// noise at a few ns per particle instead of ~25 ns with std::normal_distribution.
+constexpr int kNormalTableBits = 12;
 double inverseNormalCdf(double p) {
   // Safeguarded Newton on Phi(x) - p = 0, Phi(x) = erfc(-x / sqrt 2) / 2: bisection whenever a Newton step
   // leaves the bracket.
@@ -113,6 +114,7 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   const std::string problem = params_.validate();
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
   graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion);
+  edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   node_scratch_a_.assign(map_->numNodes(), 0.0);
   node_scratch_b_.assign(map_->numNodes(), 0.0);
   reset();
@@ -271,7 +273,7 @@ bool TopologicalParticleFilter::predictTo(double stamp) {
   belief_.stamp = stamp;
   belief_.reinitialised = false;
   ++counters_.predictions;
-  recordBelief(false);
+  recordBelief(true);
   return true;
 }
 
@@ -282,6 +284,7 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
   particles_.resize(n);
   resampled_.resize(n);
   weights_.resize(n);
+  spare_bits_.assign(n, 0u);
   std::normal_distribution<double> vel(params_.velocity_init_mean, std::sqrt(params_.velocity_init_variance));
   std::vector<double> cumulative;
   if (obs.identifying) {
@@ -309,70 +312,92 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
 
 void TopologicalParticleFilter::predict(double dt) {
   // Eqs. 2-7, one jump at most per particle and step; see the header for the reading of Eqs. 3 and 7.
+  // The same pass counts the predicted particles per node (node_scratch_b_, touched_) for the JSD / belief.
   const MotionGraph& g = *graph_;
   const double inv_window = 1.0 / params_.velocity_window;
+  std::vector<double>& count = node_scratch_b_;
+  touched_.clear();
+  const bool consistent = params_.step_consistent_jumps;
   if (params_.motion_model == MotionModel::kFixedLambda) {
-    for (Particle& p : particles_) {
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      Particle& p = particles_[i];
       const double tau = static_cast<double>(p.dwell) + dt;
       const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
-      const double u = uniform01(rng_);
-      const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
+      const std::uint64_t bits = rng_();
+      spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
+      const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32;
+      // Exponential dwell: conditional on not having jumped yet, 1 - exp(-lambda dt) (step consistent), or
+      // the cumulative 1 - exp(-lambda tau) at every step (literal).
+      const double r = 1.0 - std::exp(-params_.fixed_lambda * (consistent ? dt : tau));
       if (begin == end || !(u < r)) {
         p.dwell = static_cast<float>(tau);
-        continue;
+      } else {
+        // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
+        const std::uint32_t k =
+            begin + std::min<std::uint32_t>(end - begin - 1, static_cast<std::uint32_t>((u / r) * (end - begin)));
+        p.node = g.arcs[k].target;
+        p.dwell = 0.0f;
       }
-      // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
-      const std::uint32_t k = begin + std::min<std::uint32_t>(end - begin - 1,
-                                                              static_cast<std::uint32_t>((u / r) * (end - begin)));
-      p.node = g.arcs[k].target;
-      p.dwell = 0.0f;
+      if (count[p.node] == 0.0) touched_.push_back(p.node);
+      count[p.node] += 1.0;
     }
     return;
   }
-  std::vector<double>& contrib = edge_scratch_;
-  if (contrib.size() < g.max_degree) contrib.resize(g.max_degree);
-  for (Particle& p : particles_) {
-    const double tau = static_cast<double>(p.dwell) + dt;
+  std::vector<double>& contrib = edge_scratch_;  // (sized to the largest degree at construction)
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    Particle& p = particles_[i];
+    const double tau0 = static_cast<double>(p.dwell), tau = tau0 + dt;
     const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
     const double vx = p.vx, vy = p.vy;
-    double sum_b = 0.0, sum_c = 0.0;
+    const std::uint64_t bits = rng_();
+    spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
+    // Per arc: b (Eq. 2), survival e1 = exp(lambda tau) at the dwell reached and e0 = exp(lambda tau0) at the
+    // last step (1 in literal mode). Jump to k in this step with probability b_k (e0_k - e1_k) / sum b e0:
+    // literal mode = Eq. 2 / 3 at tau; step-consistent mode = the same conditioned on no earlier jump.
+    double sum_b = 0.0, sum_c = 0.0, denom = 0.0;
     for (std::uint32_t e = begin; e < end; ++e) {
       const auto& arc = g.arcs[e];
       const double b = std::max(0.0, vx * arc.ux + vy * arc.uy);
-      double c = 0.0;
-      if (b > 0.0) c = b * (1.0 - std::exp(arc.rate * b * tau));  // b (1 - exp(lambda tau)), Eq. 6
+      double c = 0.0, e0 = 1.0;
+      if (b > 0.0) {
+        const double e1 = std::exp(arc.rate * b * tau);  // exp(lambda tau), lambda of Eq. 6
+        if (consistent && tau0 > 0.0) e0 = std::exp(arc.rate * b * tau0);
+        c = b * (e0 - e1);
+      }
       contrib[e - begin] = c;
       sum_b += b;
       sum_c += c;
+      denom += b * e0;
     }
-    const double u = uniform01(rng_) * sum_b;  // jump with probability sum_c / sum_b (Eq. 2)
+    if (!(denom > 1e-300)) denom = sum_b;  // survival underflowed: the particle is overdue, use Eq. 2 as is
+    const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32 * denom;  // jump w.p. sum_c / denom
     if (!(u < sum_c)) {
       p.dwell = static_cast<float>(tau);
-      continue;
+    } else {
+      std::uint32_t e = begin;
+      double acc = contrib[0];
+      while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
+      // Pr(q') of Eq. 7: Eq. 2-3 probability of the transition taken at the dwell reached (rate independent).
+      const auto& taken = g.arcs[e];
+      const double b_taken = std::max(0.0, vx * taken.ux + vy * taken.uy);
+      const double pr = b_taken * (1.0 - std::exp(taken.rate * b_taken * tau)) / sum_b;
+      const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
+      const auto& arc = g.arcs[e];
+      const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
+      p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
+      p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
+      p.node = arc.target;
+      p.dwell = 0.0f;
     }
-    std::uint32_t e = begin;
-    double acc = contrib[0];
-    while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
-    const double pr = contrib[e - begin] / sum_b;  // Pr(q') of the transition taken
-    const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
-    const auto& arc = g.arcs[e];
-    const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
-    p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
-    p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
-    p.node = arc.target;
-    p.dwell = 0.0f;
+    if (count[p.node] == 0.0) touched_.push_back(p.node);
+    count[p.node] += 1.0;
   }
 }
 
 double TopologicalParticleFilter::observationJsd(const core::Observation& obs, double sum_likelihood) {
-  // JSD between the particles' node distribution Q and L / sum L over their joint support, in O(particles +
-  // support). node_scratch_b_ holds particle counts (cleared before returning).
+  // JSD between the particles' node distribution Q and L / sum L over their joint support, in O(support).
+  // node_scratch_b_ / touched_ hold the predicted particle counts left by predict() (cleared here).
   std::vector<double>& count = node_scratch_b_;
-  touched_.clear();
-  for (const Particle& p : particles_) {
-    if (count[p.node] == 0.0) touched_.push_back(p.node);
-    count[p.node] += 1.0;
-  }
   const double inv_n = 1.0 / static_cast<double>(particles_.size());
   auto term = [](double x, double y) { return x > 0.0 ? x * std::log2(2.0 * x / (x + y)) : 0.0; };
   double s = 0.0;
@@ -528,36 +553,41 @@ void TopologicalParticleFilter::addNoise() {
       particles_[i].dwell = 0.0f;
     }
   }
-  // One 64-bit draw per particle: two 16-bit normal-table indices and 32 bits for the dwell noise. The
+  // The 32 spare random bits of each particle's prediction draw (spare_bits_, see normalTable()). The
   // velocity is left alone by the fixed-lambda model, which neither uses nor estimates it. The same pass
   // counts the particles per node (node_scratch_b_, touched_) for the entropy.
   const float sigma = static_cast<float>(std::sqrt(params_.velocity_noise_variance));
   const float mu = static_cast<float>(params_.velocity_noise_mean);
   const float lo = static_cast<float>(params_.dwell_noise_min);
-  const float span = static_cast<float>((params_.dwell_noise_max - params_.dwell_noise_min) * 0x1.0p-32);
+  const float step = static_cast<float>((params_.dwell_noise_max - params_.dwell_noise_min) / 255.0);
   const float* normal = normalTable().data();
+  constexpr std::uint32_t kMask = (1u << kNormalTableBits) - 1u;
   const bool velocity = params_.motion_model == MotionModel::kVelocity;
   std::vector<double>& count = node_scratch_b_;
   touched_.clear();
-  for (Particle& p : particles_) {
-    const std::uint64_t r = rng_();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    Particle& p = particles_[i];
+    const std::uint32_t r = spare_bits_[i];
     if (velocity) {
-      p.vx += mu + sigma * normal[r & 0xffff];
-      p.vy += mu + sigma * normal[(r >> 16) & 0xffff];
+      p.vx += mu + sigma * normal[r & kMask];
+      p.vy += mu + sigma * normal[(r >> kNormalTableBits) & kMask];
     }
-    p.dwell = std::max(0.0f, p.dwell + lo + span * static_cast<float>(r >> 32));
+    p.dwell = std::max(0.0f, p.dwell + lo + step * static_cast<float>(r >> 24));
     if (count[p.node] == 0.0) touched_.push_back(p.node);
     count[p.node] += 1.0;
   }
 }
 
-void TopologicalParticleFilter::recordBelief(bool /*with_weights*/) {
+void TopologicalParticleFilter::recordBelief(bool counted) {
   // Belief from the particles alone (equal weights): after a prediction, or when weighting was skipped.
+  // counted: node_scratch_b_ / touched_ already hold the particle counts (left by predict()).
   std::vector<double>& count = node_scratch_b_;
-  touched_.clear();
-  for (const Particle& p : particles_) {
-    if (count[p.node] == 0.0) touched_.push_back(p.node);
-    count[p.node] += 1.0;
+  if (!counted) {
+    touched_.clear();
+    for (const Particle& p : particles_) {
+      if (count[p.node] == 0.0) touched_.push_back(p.node);
+      count[p.node] += 1.0;
+    }
   }
   std::sort(touched_.begin(), touched_.end());
   const double inv_n = 1.0 / static_cast<double>(particles_.size());

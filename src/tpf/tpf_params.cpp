@@ -113,6 +113,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "velocity_window", p.velocity_window);
   read(node, "min_jump_dwell", p.min_jump_dwell);
   read(node, "directed_motion", p.directed_motion);
+  read(node, "step_consistent_jumps", p.step_consistent_jumps);
   if (const YAML::Node g = node["sensor_gammas"]) {
     if (!g.IsMap()) throw std::runtime_error("tpf params: 'sensor_gammas' must be a map");
     for (const auto& kv : g) {

@@ -20,8 +20,14 @@
 //    so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen. Without any
 //    positive projection (sum b = 0) a particle stays.
 //  * tau in Eq. 2 is the dwell time at the prediction instant (tau_t + dt); at most one jump per prediction.
+//    With step_consistent_jumps (default) Eq. 2 is read as the probability of having left the node after
+//    dwelling tau, and a step from tau_t to tau_t + dt jumps with the conditional probability
+//    sum_k b_k (exp(l_k tau_t) - exp(l_k (tau_t + dt))) / sum_k b_k exp(l_k tau_t): one 3 s step and thirty
+//    0.1 s steps move the particles alike (the literal reading applies Eq. 2 afresh at every observation, so
+//    particles would run faster the more sensors report). A step with dt = 0 never jumps.
 //  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector along
-//    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the probability of the transition taken; a
+//    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the Eq. 2-3 probability of the transition taken
+//    at the dwell reached (transitionProbabilities(), independent of the step length); a
 //    particle that stays keeps its velocity (the literal d = 0 case would decay it towards 0 while waiting).
 //  * Eq. 8: L enters normalised to its maximum (likelihood scale is arbitrary, see core::Observation), the
 //    Gaussian g is unnormalised (peak 1) with sigma = max(|v^s|/2, min_velocity_sigma); w_v = 0 when the
@@ -30,7 +36,7 @@
 //    predicted particles are kept, status kAccepted with reason "no overlap".
 //  * JSD (base-2 logs, so in [0, 1]) and entropy H (nats) over the support present. p_rj follows Algorithm 1:
 //    set to unconnected_jump_probability at start and on re-initialisation, to 0 once H < epsilon_H.
-//  * Eq. 12 velocity noise: inverse-transform sampling on a 65,536-quantile grid of N(0, 1) (speed; see code).
+//  * Eq. 12 velocity noise: inverse-transform sampling on a 4,096-quantile grid of N(0, 1) (speed; see code).
 //  * Late observations: stamp < last update stamp but within reorder_window are fused at the current time
 //    with no prediction (status kReordered); older ones are dropped and counted (kDroppedTooOld). The filter
 //    never predicts backwards.
@@ -136,8 +142,8 @@ class TopologicalParticleFilter {
   static double edgeJumpProbability(double lambda, double dwell);
   // Eq. 2 for particle state (node, velocity, dwell): probability of leaving the node.
   double jumpProbability(topology::NodeIndex node, double vx, double vy, double dwell) const;
-  // Eq. 2-3 per neighbour: probability of jumping to each motion neighbour of `node` (same order as
-  // motionNeighbours(node)); sums to jumpProbability().
+  // Eq. 2-3 per neighbour: probability of having jumped to each motion neighbour of `node` after dwelling
+  // `dwell` (same order as motionNeighbours(node)); sums to jumpProbability().
   std::vector<double> transitionProbabilities(topology::NodeIndex node, double vx, double vy,
                                               double dwell) const;
   // Eq. 8 weight of a particle for a likelihood value L^ in [0, 1] (already normalised to its maximum).
@@ -158,7 +164,7 @@ class TopologicalParticleFilter {
   bool weightAndResample(const core::Observation& obs, double max_likelihood);
   void resample(double total_weight);
   void addNoise();
-  void recordBelief(bool with_weights);
+  void recordBelief(bool counted);
   void fuse(const core::Observation& obs, double dt, UpdateResult& result);
 
   std::shared_ptr<const topology::TopologicalMap> map_;
@@ -174,6 +180,7 @@ class TopologicalParticleFilter {
   std::vector<double> node_scratch_a_, node_scratch_b_;
   std::vector<topology::NodeIndex> touched_;
   std::vector<double> edge_scratch_;  // per-edge jump contributions of one particle (max degree)
+  std::vector<std::uint32_t> spare_bits_;  // per particle: random bits of the prediction draw used by Eq. 12
 
   double unconnected_p_ = 0.0;  // p_rj
   Belief belief_;

@@ -56,6 +56,11 @@ struct TpfParams {
   double velocity_window = 10.0;   // V of Eq. 7 (dimensionless number of steps; not in Table I)
   double min_jump_dwell = 0.1;     // s, floor on the dwell time used for the observed speed of Eq. 7
   bool directed_motion = false;    // true: particles follow file edge direction; false: undirected graph
+  // true: Eq. 2 is the probability of having left the node after dwelling tau, so a prediction step of dt
+  // jumps with the conditional probability 1 - S(tau + dt) / S(tau), S = 1 - Eq. 2 (the motion no longer
+  // depends on how often observations arrive). false: Eq. 2 at tau is applied at every prediction (paper
+  // read literally; particles move faster the more sensors report).
+  bool step_consistent_jumps = true;
 
   // --- Eq. 8, weighting ------------------------------------------------------------------------------------
   // Keyed by Observation::sensor. Table I: gnss (1, 1), lidar (0.25, 0), rfid (1, 0). Choices for sensors
