@@ -1,3 +1,9 @@
 # sensors_ranging tests: core gtests (no roscore), the GNSS bag test, rostests of the three nodes.
 pl_add_gtest(test_sensors_ranging test/test_sensors_ranging.cpp LIBS picker_localisation_sensors_ranging)
 pl_add_gtest(test_gnss_bag test/test_gnss_bag.cpp LIBS picker_localisation_sensors_ranging_ros)
+add_rostest_gtest(test_gnss_ingest_node test/gnss_ingest.test test/test_gnss_ingest_node.cpp)
+target_link_libraries(test_gnss_ingest_node picker_localisation_ros picker_localisation_sensors_ranging)
+add_rostest_gtest(test_rfid_ranging_node test/rfid_ranging.test test/test_rfid_ranging_node.cpp)
+target_link_libraries(test_rfid_ranging_node picker_localisation_ros)
+add_rostest_gtest(test_uwb_ranging_node test/uwb_ranging.test test/test_uwb_ranging_node.cpp)
+target_link_libraries(test_uwb_ranging_node picker_localisation_ros)

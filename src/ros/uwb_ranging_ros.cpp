@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
@@ -66,7 +67,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   for (const std::string& t : uwb_topics) subs_.push_back(nh.subscribe(t, 200, &UwbRangingNode::onRange, this));
   for (const std::string& t : bearing_topics)
     subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
-  flush_timer_ = nh.createTimer(ros::Duration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
+  flush_timer_ = nh.createWallTimer(ros::WallDuration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
   updater_.setHardwareID("uwb_ranging");
   updater_.add("UWB ranging", this, &UwbRangingNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
@@ -107,6 +108,9 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
   }
   sensors::UwbRangeInput in;
   in.stamp = msg->header.stamp.toSec();
+  last_arrival_ = ros::WallTime::now();
+  newest_stamp_ = have_range_ ? std::max(newest_stamp_, in.stamp) : in.stamp;
+  have_range_ = true;
   in.robot_id = msg->robot_id;
   in.tag_id = msg->tag_id;
   in.anchor_id = msg->header.frame_id;
@@ -142,9 +146,13 @@ void UwbRangingNode::onBearings(const picker_localisation::BearingDetectionArray
   ++bearing_sets_;
 }
 
-void UwbRangingNode::onFlush(const ros::TimerEvent&) {
+// Batches close on message stamps (the newest range seen), so a delayed or replayed stream is batched the same
+// way; when no range has arrived for batch_window s of wall time, every open batch is closed.
+void UwbRangingNode::onFlush(const ros::WallTimerEvent&) {
+  if (!have_range_) return;
   std::vector<core::Observation> out;
-  uwb_->flush(ros::Time::now().toSec(), &out);
+  const bool quiet = (ros::WallTime::now() - last_arrival_).toSec() > uwb_->options().batch_window;
+  uwb_->flush(quiet ? std::numeric_limits<double>::infinity() : newest_stamp_, &out);
   publish(out);
 }
 

@@ -92,7 +92,7 @@ class UwbRangingNode {
  private:
   void onRange(const picker_localisation::UwbRange::ConstPtr& msg);
   void onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg);
-  void onFlush(const ros::TimerEvent&);
+  void onFlush(const ros::WallTimerEvent&);
   void publish(const std::vector<core::Observation>& obs);
   std::string baseFrame(const std::string& robot_id) const;
   // Mount of a sensor frame in base_link (cached: mounts are static).
@@ -110,10 +110,13 @@ class UwbRangingNode {
   std::map<std::string, Eigen::Isometry2d> mounts_;
   std::vector<ros::Subscriber> subs_;
   ros::Publisher pub_;
-  ros::Timer flush_timer_;
+  ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
   std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
+  bool have_range_ = false;
+  double newest_stamp_ = 0.0;     // newest accepted-or-not range stamp (s)
+  ros::WallTime last_arrival_;    // wall time of the last range message
 };
 
 }  // namespace ros_adapter

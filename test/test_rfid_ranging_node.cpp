@@ -1,0 +1,84 @@
+// rostest: rfid_ranging through ROS. Unknown tag, missing tf (unknown and empty antenna frame) and a stamp
+// going backwards publish nothing and do not stop the node; good reads before and after become identifying
+// Observations over the nodes within read range of the antenna's tf pose; negative information for the
+// pickers not read; diagnostics count the drops.
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <picker_localisation/RfidReading.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <cmath>
+
+#include "ranging_rostest_util.h"
+
+namespace {
+picker_localisation::RfidReading reading(const std::string& tag, const std::string& frame, const ros::Time& stamp) {
+  picker_localisation::RfidReading r;
+  r.header.stamp = stamp;
+  r.header.frame_id = frame;
+  r.robot_id = "robot_1";
+  r.tag_id = tag;
+  r.rssi = -55.0;
+  return r;
+}
+}  // namespace
+
+TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "RFID ranging");
+  tf2_ros::StaticTransformBroadcaster tf;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = "map";
+  t.child_frame_id = "robot_1/rfid_antenna";
+  t.transform.translation.x = 20.0;
+  t.transform.translation.y = -20.0;
+  t.transform.rotation.w = 1.0;
+  tf.sendTransform(t);
+  ros::Publisher pub = nh.advertise<picker_localisation::RfidReading>("/robot_1/rfid", 50);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return pub.getNumSubscribers() > 0 && c.obs_sub.getNumPublishers() > 0; }, 30.0));
+  ranging_test::spinFor(0.5);  // let the node's tf listener receive the static transform
+  const ros::Time t0 = ros::Time::now();
+  auto send = [&](const picker_localisation::RfidReading& r, double wait = 0.05) {
+    pub.publish(r);
+    ranging_test::spinFor(wait);
+  };
+  send(reading("stranger", "robot_1/rfid_antenna", t0));  // unknown tag
+  send(reading("rfid_0001", "robot_1/ghost", t0), 0.4);    // no tf for this frame: bounded wait, dropped
+  send(reading("rfid_0001", "", t0));                      // empty frame
+  send(reading("rfid_0001", "robot_1/rfid_antenna", t0));  // good
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }, 10.0));
+  send(reading("rfid_0001", "robot_1/rfid_antenna", t0 - ros::Duration(2.0)));  // backwards
+  for (int i = 1; i <= 6; ++i) send(reading("rfid_0001", "robot_1/rfid_antenna", t0 + ros::Duration(0.25 * i)));
+  // 7 positives for picker_1; after 1 s of reading, one negative each for picker_2 and picker_3.
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 9; }, 10.0));
+  ranging_test::spinFor(0.5);
+  ASSERT_EQ(c.obs.size(), 9u);
+  EXPECT_EQ(ranging_test::countFor(c.obs, "picker_1"), 7u);
+  EXPECT_EQ(ranging_test::countFor(c.obs, "picker_2"), 1u);
+  EXPECT_EQ(ranging_test::countFor(c.obs, "picker_3"), 1u);
+  for (const auto& o : c.obs) {
+    EXPECT_TRUE(o.identifying);
+    EXPECT_EQ(o.sensor, "rfid");
+    EXPECT_EQ(o.robot_id, "robot_1");
+    ASSERT_EQ(o.nodes.size(), o.likelihood.size());
+    if (o.picker_id == "picker_1") {
+      EXPECT_NEAR(o.position.x, 20.0, 1e-9);
+      EXPECT_NEAR(o.position.y, -20.0, 1e-9);
+      for (double l : o.likelihood) EXPECT_EQ(l, 1.0);
+    } else {
+      EXPECT_EQ(o.nodes.size(), 138u);  // negative: every node of the Riseholme map
+      EXPECT_NEAR(*std::min_element(o.likelihood.begin(), o.likelihood.end()), 0.3, 1e-9);
+    }
+  }
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2"; }, 5.0)) << c.diag["dropped: no tf"];
+  EXPECT_EQ(c.diag["rejected: unknown tag"], "1");
+  EXPECT_EQ(c.diag["rejected: out of order"], "1");
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_rfid_ranging_node");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
