@@ -1,5 +1,6 @@
-// rostest: farm_sim drives /clock, publishes tf per robot, every raw sensor topic and the pickers' ground truth,
-// and drives a robot to a goal node sent on /<robot>/goal (unknown goals are ignored, the node keeps running).
+// rostest: farm_sim drives /clock, publishes tf per robot, every raw sensor topic and the pickers' ground
+// truth, and drives a robot to a goal node sent on /<robot>/goal (unknown goals are ignored, the node keeps
+// running).
 #include <geometry_msgs/PoseStamped.h>
 #include <gtest/gtest.h>
 #include <picker_localisation/BearingDetectionArray.h>
@@ -38,11 +39,12 @@ struct Recorder {
     }));
   }
   void pose(ros::NodeHandle& nh, const std::string& topic) {
-    subs.push_back(nh.subscribe<geometry_msgs::PoseStamped>(topic, 100, [this, topic](const geometry_msgs::PoseStamped::ConstPtr& m) {
-      std::lock_guard<std::mutex> l(mutex);
-      ++counts[topic];
-      last_pose[topic] = *m;
-    }));
+    subs.push_back(nh.subscribe<geometry_msgs::PoseStamped>(
+        topic, 100, [this, topic](const geometry_msgs::PoseStamped::ConstPtr& m) {
+          std::lock_guard<std::mutex> l(mutex);
+          ++counts[topic];
+          last_pose[topic] = *m;
+        }));
   }
   int get(const std::string& topic) {
     std::lock_guard<std::mutex> l(mutex);
@@ -86,11 +88,12 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   // /clock advances.
   ASSERT_TRUE(waitFor([] { return ros::Time::now().toSec() > 0.0; }, 30.0)) << "no /clock";
   const ros::Time t0 = ros::Time::now();
-  ASSERT_TRUE(waitFor([&] { return (ros::Time::now() - t0).toSec() > 10.0; }, 30.0)) << "/clock does not advance";
+  ASSERT_TRUE(waitFor([&] { return (ros::Time::now() - t0).toSec() > 10.0; }, 30.0))
+      << "/clock does not advance";
   const ros::Time t1 = ros::Time::now();
 
   // Every topic published at roughly its simulated rate during those 10 s.
-  EXPECT_GE(rec.get("/robot_1/scan_front"), 60);   // 10 Hz
+  EXPECT_GE(rec.get("/robot_1/scan_front"), 60);  // 10 Hz
   EXPECT_GE(rec.get("/robot_1/scan_rear"), 60);
   EXPECT_GE(rec.get("/robot_1/uwb"), 1);
   EXPECT_GE(rec.get("/robot_1/camera/detections"), 30);  // 5 Hz x 2 cameras, empty arrays included
@@ -103,8 +106,8 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
   ASSERT_TRUE(waitFor([&] { return buffer.canTransform("map", "robot_1/base_link", ros::Time(0)); }, 10.0));
-  for (const char* f : {"robot_1/laser_front", "robot_1/laser_rear", "robot_1/uwb_anchor_1", "robot_1/camera_1",
-                        "robot_1/rfid_left"})
+  for (const char* f : {"robot_1/laser_front", "robot_1/laser_rear", "robot_1/uwb_anchor_1",
+                        "robot_1/camera_1", "robot_1/rfid_left"})
     EXPECT_TRUE(waitFor([&] { return buffer.canTransform("robot_1/base_link", f, ros::Time(0)); }, 5.0)) << f;
   const auto laser = buffer.lookupTransform("robot_1/base_link", "robot_1/laser_front", ros::Time(0));
   EXPECT_NEAR(laser.transform.translation.x, 0.78, 1e-6);

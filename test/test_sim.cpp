@@ -54,7 +54,9 @@ double distanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, con
   return (a + t * ab - p).norm();
 }
 
-double mean(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }
+double mean(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+}
 double stddev(const std::vector<double>& v) {
   const double m = mean(v);
   double s = 0.0;
@@ -145,7 +147,8 @@ TEST(LaneTour, MapWithoutLanesUsesWaypoints) {
   EXPECT_THROW(buildLaneTour(map, layout, 0), std::invalid_argument);
   const auto tour = buildLaneTour(map, layout, 0, {0, 15, 3});
   ASSERT_GE(tour.size(), 2u);
-  for (std::size_t k = 0; k < tour.size(); ++k) EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()]));
+  for (std::size_t k = 0; k < tour.size(); ++k)
+    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()]));
   EXPECT_EQ(tour.front(), 0u);
   EXPECT_NE(std::find(tour.begin(), tour.end(), 15u), tour.end());
 }
@@ -395,7 +398,8 @@ TEST(GnssModel, DatumFileKeys) {
   const std::string path = ::testing::TempDir() + "/datum_test.yaml";
   {
     std::ofstream f(path);
-    f << "datum:\n  type: local_cartesian\n  latitude: 53.1\n  longitude: -0.6\n  altitude: 12.0\n  heading_deg: 15.0\n";
+    f << "datum:\n  type: local_cartesian\n  latitude: 53.1\n  longitude: -0.6\n  altitude: 12.0\n  "
+         "heading_deg: 15.0\n";
   }
   const MapDatum d = loadMapDatum(path);
   EXPECT_DOUBLE_EQ(d.latitude, 53.1);
@@ -470,8 +474,10 @@ TEST(LaserModel, BeamWindowsMatchTestingEveryBeam) {
       for (const auto& c : scene.circles) r = std::min(r, rayCircle(pose.position(), d, c));
       for (const auto& sg : scene.segments) r = std::min(r, raySegment(pose.position(), d, sg));
       if (r < params.range_min) continue;  // -inf (too close) or inside a circle
-      if (std::isinf(r)) EXPECT_TRUE(std::isinf(scan.ranges[i])) << trial << " " << i;
-      else EXPECT_NEAR(scan.ranges[i], r, 1e-4) << trial << " " << i;
+      if (std::isinf(r))
+        EXPECT_TRUE(std::isinf(scan.ranges[i])) << trial << " " << i;
+      else
+        EXPECT_NEAR(scan.ranges[i], r, 1e-4) << trial << " " << i;
     }
   }
 }
@@ -482,7 +488,8 @@ TEST(LaserModel, OtherRobotsAreObstacles) {
   LaneLayout layout(map);
   SimConfig c = quietConfig();
   c.num_robots = 2;
-  c.robot_start_nodes = {map.node(layout.lanes()[1].nodes[4]).name, map.node(layout.lanes()[2].nodes[4]).name};
+  c.robot_start_nodes = {map.node(layout.lanes()[1].nodes[4]).name,
+                         map.node(layout.lanes()[2].nodes[4]).name};
   c.robot_motion.patrol = PatrolPolicy::kStay;
   c.clutter.bed_posts = false;
   c.laser.range_noise_std = 0.0;
@@ -496,9 +503,11 @@ TEST(LaserModel, OtherRobotsAreObstacles) {
     for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
       if (!std::isfinite(scan.ranges[b])) continue;
       const double a = scan.sensor_pose.yaw + scan.angle_min + b * scan.angle_increment;
-      const Eigen::Vector2d hit = scan.sensor_pose.position() + scan.ranges[b] * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const Eigen::Vector2d hit =
+          scan.sensor_pose.position() + scan.ranges[b] * Eigen::Vector2d(std::cos(a), std::sin(a));
       const Eigen::Vector2d local = other.inverseTransform(hit);
-      if (std::abs(std::abs(local.x()) - hl) < 1e-3 || std::abs(std::abs(local.y()) - hw) < 1e-3) ++hits_on_other;
+      if (std::abs(std::abs(local.x()) - hl) < 1e-3 || std::abs(std::abs(local.y()) - hw) < 1e-3)
+        ++hits_on_other;
     }
   }
   EXPECT_GT(hits_on_other, 20);
@@ -539,7 +548,8 @@ TEST(LaserModel, SimulatorScanSeesPickerLegs) {
       for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
         if (!std::isfinite(scan.ranges[b])) continue;
         const double a = scan.sensor_pose.yaw + scan.angle_min + b * scan.angle_increment;
-        const Eigen::Vector2d hit = scan.sensor_pose.position() + scan.ranges[b] * Eigen::Vector2d(std::cos(a), std::sin(a));
+        const Eigen::Vector2d hit =
+            scan.sensor_pose.position() + scan.ranges[b] * Eigen::Vector2d(std::cos(a), std::sin(a));
         const double d = std::min((hit - legs[0]).norm(), (hit - legs[1]).norm());
         // Every return lies on a leg circle (the only obstacles here), and some are seen.
         EXPECT_NEAR(d, 0.06, 0.02);
@@ -616,7 +626,8 @@ TEST(CameraModel, BoxesOnlyInsideTheFieldOfView) {
   for (int k = 0; k < 20000; ++k) {
     const Eigen::Vector2d pos(u(rng), u(rng));
     const Eigen::Vector2d q = cam.inverseTransform(pos);
-    const bool in_fov = q.x() > 0.3 && std::abs(std::atan2(q.y(), q.x())) <= p.hfov / 2 && q.norm() <= p.max_range;
+    const bool in_fov =
+        q.x() > 0.3 && std::abs(std::atan2(q.y(), q.x())) <= p.hfov / 2 && q.norm() <= p.max_range;
     const auto boxes = simulateCamera(p, cam, 1.2, {pos}, rng);
     if (!in_fov) {
       EXPECT_TRUE(boxes.empty()) << pos.transpose();
@@ -630,7 +641,8 @@ TEST(CameraModel, BoxesOnlyInsideTheFieldOfView) {
     EXPECT_LE(b.x_offset + b.width, p.image_width);
     EXPECT_GE(b.y_offset, 0);
     EXPECT_LE(b.y_offset + b.height, p.image_height);
-    // Bearing of the noisy box centre: within a few pixels' worth of the truth (unless clipped at the border).
+    // Bearing of the noisy box centre: within a few pixels' worth of the truth (unless clipped at the
+    // border).
     if (std::abs(b.true_bearing) < p.hfov / 2 - 0.1 && b.true_distance > 2.0)
       EXPECT_NEAR(b.bearing, b.true_bearing, 0.02);
   }
@@ -713,7 +725,8 @@ TEST(FarmSimulator, DeterministicWithTheSameSeed) {
   // A different seed gives different numbers.
   bool differs = false;
   for (std::size_t k = 0; k < std::min(oa.gnss.size(), oo.gnss.size()); ++k)
-    if (oa.gnss[k].status == 0 && oo.gnss[k].status == 0 && oa.gnss[k].latitude != oo.gnss[k].latitude) differs = true;
+    if (oa.gnss[k].status == 0 && oo.gnss[k].status == 0 && oa.gnss[k].latitude != oo.gnss[k].latitude)
+      differs = true;
   EXPECT_TRUE(differs);
 }
 
@@ -744,9 +757,9 @@ TEST(FarmSimulator, SensorRatesAndStamps) {
   FarmSimulator sim(map, c);
   const auto out = sim.advanceTo(10.0);
   EXPECT_DOUBLE_EQ(sim.time(), 10.0);
-  EXPECT_EQ(out.gnss.size(), 10u * 3u);                       // 1 Hz x 3 pickers
-  EXPECT_EQ(out.scans.size(), 100u * 2u);                     // 10 Hz x 2 lasers x 1 robot
-  EXPECT_EQ(out.camera.size(), 50u * 2u);                     // 5 Hz x 2 cameras
+  EXPECT_EQ(out.gnss.size(), 10u * 3u);    // 1 Hz x 3 pickers
+  EXPECT_EQ(out.scans.size(), 100u * 2u);  // 10 Hz x 2 lasers x 1 robot
+  EXPECT_EQ(out.camera.size(), 50u * 2u);  // 5 Hz x 2 cameras
   for (std::size_t k = 0; k < out.gnss.size(); ++k)
     EXPECT_NEAR(out.gnss[k].stamp, 1.0 + static_cast<double>(k / 3), 1e-9);
   EXPECT_THROW(sim.advanceTo(5.0), std::invalid_argument);
@@ -763,9 +776,12 @@ class FarmSimulatorOnMaps : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(FarmSimulatorOnMaps, RunsAndKeepsPickersOnTheGraph) {
   topology::TopologicalMap map;
-  if (GetParam() == "polytunnel") map = polytunnel(10, 12);
-  else if (GetParam() == "grid") map = gridMap();
-  else map = topology::loadMap(GetParam());
+  if (GetParam() == "polytunnel")
+    map = polytunnel(10, 12);
+  else if (GetParam() == "grid")
+    map = gridMap();
+  else
+    map = topology::loadMap(GetParam());
   SimConfig c = quietConfig(17);
   c.num_robots = 2;
   FarmSimulator sim(map, c);
@@ -787,7 +803,9 @@ TEST_P(FarmSimulatorOnMaps, RunsAndKeepsPickersOnTheGraph) {
     FarmSimulator fresh(map, c2);
     for (std::size_t i = 0; i < fresh.numPickers(); ++i) {
       EXPECT_NE(fresh.pickerLane(i), topology::kNoLane);
-      const auto& lane = fresh.laneLayout().lanes()[static_cast<std::size_t>(fresh.laneLayout().orderOf(fresh.pickerLane(i)))];
+      const auto& lane =
+          fresh.laneLayout()
+              .lanes()[static_cast<std::size_t>(fresh.laneLayout().orderOf(fresh.pickerLane(i)))];
       EXPECT_EQ(fresh.picker(i).state().from, lane.entry_end());
     }
     EXPECT_FALSE(sim.posts().empty());
@@ -814,7 +832,8 @@ TEST(SimConfig, ShippedYamlLoadsAndUnknownKeysFail) {
   SimConfig e;
   EXPECT_THROW(applySimConfigYaml(YAML::Load("gnss: {drift_sd: 2}"), e, "x.yaml"), std::runtime_error);
   EXPECT_THROW(applySimConfigYaml(YAML::Load("gnss: {drift_std: abc}"), e, "x.yaml"), std::runtime_error);
-  EXPECT_THROW(applySimConfigYaml(YAML::Load("robot_motion: {patrol: fly}"), e, "x.yaml"), std::runtime_error);
+  EXPECT_THROW(applySimConfigYaml(YAML::Load("robot_motion: {patrol: fly}"), e, "x.yaml"),
+               std::runtime_error);
   applySimConfigYaml(YAML::Load("seed: 9\nenable: {camera: false}\nrobots: 2"), e, "x.yaml");
   EXPECT_EQ(e.seed, 9u);
   EXPECT_FALSE(e.enable.camera);

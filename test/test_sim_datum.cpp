@@ -1,5 +1,5 @@
-// Round trip across areas: fixes the simulator produces through config/datum.yaml, turned back into map metres
-// by the Ranging engineer's GeodeticDatum (what gnss_ingest does), land on truth + the injected error.
+// Round trip across areas: fixes the simulator produces through config/datum.yaml, turned back into map
+// metres by the Ranging engineer's GeodeticDatum (what gnss_ingest does), land on truth + the injected error.
 #include <gtest/gtest.h>
 
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"

@@ -27,7 +27,8 @@ geometry_msgs::Quaternion yawQuaternion(double yaw) {
 }
 
 geometry_msgs::TransformStamped planarTransform(const ros::Time& stamp, const std::string& parent,
-                                                const std::string& child, const sim::Pose2D& p, double z = 0.0) {
+                                                const std::string& child, const sim::Pose2D& p,
+                                                double z = 0.0) {
   geometry_msgs::TransformStamped t;
   t.header.stamp = stamp;
   t.header.frame_id = parent;
@@ -137,10 +138,11 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   diag_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_);
   diag_->setHardwareID("farm_sim");
   diag_->add("simulation", this, &FarmSimNode::diagnose);
-  ROS_INFO("farm_sim: map '%s' (%zu nodes, %zu lanes), %zu pickers, %zu robots, seed %llu, rate factor %.1f, "
-           "duration %.0f s",
-           map_->name().c_str(), map_->numNodes(), sim_->laneLayout().lanes().size(), sim_->numPickers(),
-           sim_->numRobots(), static_cast<unsigned long long>(sim_->config().seed), rate_factor_, duration_);
+  ROS_INFO(
+      "farm_sim: map '%s' (%zu nodes, %zu lanes), %zu pickers, %zu robots, seed %llu, rate factor %.1f, "
+      "duration %.0f s",
+      map_->name().c_str(), map_->numNodes(), sim_->laneLayout().lanes().size(), sim_->numPickers(),
+      sim_->numRobots(), static_cast<unsigned long long>(sim_->config().seed), rate_factor_, duration_);
 }
 
 void FarmSimNode::publishStaticFrames() {
@@ -151,7 +153,8 @@ void FarmSimNode::publishStaticFrames() {
   for (std::size_t r = 0; r < sim_->numRobots(); ++r) {
     const std::string p = sim_->robot(r).id() + "/";
     for (const auto* group : {&layout.lasers, &layout.rfid_antennas, &layout.uwb_anchors, &layout.cameras})
-      for (const auto& m : *group) frames.push_back(planarTransform(stamp, p + "base_link", p + m.frame, m.pose, m.z));
+      for (const auto& m : *group)
+        frames.push_back(planarTransform(stamp, p + "base_link", p + m.frame, m.pose, m.z));
   }
   static_tf_.sendTransform(frames);
 }
@@ -260,7 +263,8 @@ void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode:
   const std::string& id = sim_->robot(robot).id();
   if (!msg->robot_id.empty() && msg->robot_id != id) {
     ++goals_rejected_;
-    ROS_WARN_THROTTLE(5.0, "farm_sim: goal on /%s/goal is for robot '%s'; ignored", id.c_str(), msg->robot_id.c_str());
+    ROS_WARN_THROTTLE(5.0, "farm_sim: goal on /%s/goal is for robot '%s'; ignored", id.c_str(),
+                      msg->robot_id.c_str());
     return;
   }
   std::optional<topology::NodeIndex> node;
@@ -271,7 +275,8 @@ void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode:
   }
   if (!node) {
     ++goals_rejected_;
-    ROS_WARN_THROTTLE(5.0, "farm_sim: goal node '%s' for %s is not on the map; ignored", msg->node.c_str(), id.c_str());
+    ROS_WARN_THROTTLE(5.0, "farm_sim: goal node '%s' for %s is not on the map; ignored", msg->node.c_str(),
+                      id.c_str());
     return;
   }
   sim_->setRobotGoal(robot, *node);
@@ -280,7 +285,8 @@ void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode:
 
 void FarmSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   const double wall = (ros::WallTime::now() - wall_start_).toSec();
-  stat.summary(diagnostic_msgs::DiagnosticStatus::OK, goals_rejected_ ? "running (some goals rejected)" : "running");
+  stat.summary(diagnostic_msgs::DiagnosticStatus::OK,
+               goals_rejected_ ? "running (some goals rejected)" : "running");
   stat.add("simulated time (s)", sim_->time());
   stat.add("achieved real-time factor", wall > 0 ? sim_->time() / wall : 0.0);
   stat.add("requested real-time factor", rate_factor_);

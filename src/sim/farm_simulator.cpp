@@ -35,7 +35,9 @@ enum Stream : std::uint64_t {
   kWaypoints = 8000,
 };
 constexpr std::uint64_t kStreamStride = 1ULL << 32;  // streams = base * stride + index
-std::uint64_t streamId(Stream s, std::size_t i) { return static_cast<std::uint64_t>(s) * kStreamStride + i; }
+std::uint64_t streamId(Stream s, std::size_t i) {
+  return static_cast<std::uint64_t>(s) * kStreamStride + i;
+}
 
 void checkRate(double rate, const char* what) {
   if (!(rate > 0.0) || !std::isfinite(rate))
@@ -56,7 +58,8 @@ FarmSimulator::FarmSimulator(const topology::TopologicalMap& map, SimConfig conf
   checkRate(config_.uwb.rate, "uwb");
   checkRate(config_.camera.rate, "camera");
   if (!(config_.laser.angle_increment > 0.0) || config_.laser.angle_max < config_.laser.angle_min)
-    throw std::invalid_argument("FarmSimulator: laser angles need angle_increment > 0 and angle_max >= angle_min");
+    throw std::invalid_argument(
+        "FarmSimulator: laser angles need angle_increment > 0 and angle_max >= angle_min");
   if (config_.pickers.empty()) {
     for (int i = 1; i <= 3; ++i) {
       PickerSpec p;
@@ -97,20 +100,23 @@ FarmSimulator::FarmSimulator(const topology::TopologicalMap& map, SimConfig conf
       for (int k = 0; k < 16; ++k) waypoints.push_back(big_nodes[pick(wrng)]);
       tour = buildLaneTour(map, layout_, 0, waypoints);
     }
-    pickers_.emplace_back(map, std::move(tour), config_.picker_motion, deriveSeed(seed, streamId(kPickerMotion, i)),
-                          0.0);
+    pickers_.emplace_back(map, std::move(tour), config_.picker_motion,
+                          deriveSeed(seed, streamId(kPickerMotion, i)), 0.0);
     gnss_.emplace_back(config_.gnss, deriveSeed(seed, streamId(kGnss, i)), 0.0);
   }
 
   // Robots.
   if (config_.robot_ids.empty())
-    for (std::size_t r = 0; r < config_.num_robots; ++r) config_.robot_ids.push_back("robot_" + std::to_string(r + 1));
+    for (std::size_t r = 0; r < config_.num_robots; ++r)
+      config_.robot_ids.push_back("robot_" + std::to_string(r + 1));
   config_.num_robots = config_.robot_ids.size();
   for (std::size_t r = 0; r < config_.num_robots; ++r) {
     NodeIndex start;
     if (r < config_.robot_start_nodes.size() && !config_.robot_start_nodes[r].empty()) {
       const auto idx = map.index(config_.robot_start_nodes[r]);
-      if (!idx) throw std::invalid_argument("FarmSimulator: unknown robot start node '" + config_.robot_start_nodes[r] + "'");
+      if (!idx)
+        throw std::invalid_argument("FarmSimulator: unknown robot start node '" +
+                                    config_.robot_start_nodes[r] + "'");
       start = *idx;
     } else if (L > 0) {
       // Spread over the lanes, at the far end (opposite to where the pickers enter).
@@ -173,7 +179,8 @@ void FarmSimulator::buildPosts() {
 }
 
 SimOutputs FarmSimulator::step(double dt) {
-  if (!(dt >= 0.0) || !std::isfinite(dt)) throw std::invalid_argument("FarmSimulator::step: dt must be finite and >= 0");
+  if (!(dt >= 0.0) || !std::isfinite(dt))
+    throw std::invalid_argument("FarmSimulator::step: dt must be finite and >= 0");
   return advanceTo(time_ + dt);
 }
 
@@ -200,7 +207,9 @@ topology::NodeIndex FarmSimulator::pickerNearestNode(std::size_t i) const {
   return pickers_.at(i).state().nearest_node;
 }
 
-topology::LaneIndex FarmSimulator::pickerLane(std::size_t i) const { return map_->lane(pickerNearestNode(i)); }
+topology::LaneIndex FarmSimulator::pickerLane(std::size_t i) const {
+  return map_->lane(pickerNearestNode(i));
+}
 
 std::optional<std::size_t> FarmSimulator::pickerIndex(const std::string& id) const {
   for (std::size_t i = 0; i < config_.pickers.size(); ++i)
@@ -214,8 +223,12 @@ std::optional<std::size_t> FarmSimulator::robotIndex(const std::string& id) cons
   return std::nullopt;
 }
 
-void FarmSimulator::setRobotGoal(std::size_t r, NodeIndex goal) { robots_.at(r).setGoal(goal); }
-void FarmSimulator::clearRobotGoal(std::size_t r) { robots_.at(r).clearGoal(); }
+void FarmSimulator::setRobotGoal(std::size_t r, NodeIndex goal) {
+  robots_.at(r).setGoal(goal);
+}
+void FarmSimulator::clearRobotGoal(std::size_t r) {
+  robots_.at(r).clearGoal();
+}
 
 LaserScene FarmSimulator::laserScene(std::size_t r) const {
   LaserScene scene;
@@ -226,8 +239,8 @@ LaserScene FarmSimulator::laserScene(std::size_t r) const {
   for (std::size_t o = 0; o < robots_.size(); ++o) {
     if (o == r) continue;
     const Pose2D& pose = robots_[o].pose();
-    const Eigen::Vector2d c[4] = {pose.transform({hl, hw}), pose.transform({-hl, hw}), pose.transform({-hl, -hw}),
-                                  pose.transform({hl, -hw})};
+    const Eigen::Vector2d c[4] = {pose.transform({hl, hw}), pose.transform({-hl, hw}),
+                                  pose.transform({-hl, -hw}), pose.transform({hl, -hw})};
     for (int k = 0; k < 4; ++k) scene.segments.push_back({c[k], c[(k + 1) % 4]});
   }
   return scene;
@@ -266,7 +279,8 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
     for (std::size_t r = 0; r < robots_.size(); ++r) {
       const LaserScene scene = laserScene(r);
       for (const auto& m : layout.lasers) {
-        LaserScan scan = castLaser(scene, robots_[r].pose().compose(m.pose), config_.laser, stamp, streams_[r]->laser);
+        LaserScan scan =
+            castLaser(scene, robots_[r].pose().compose(m.pose), config_.laser, stamp, streams_[r]->laser);
         scan.robot_id = robots_[r].id();
         scan.robot_index = r;
         scan.frame = m.frame;
@@ -275,8 +289,9 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
     }
   });
   // RFID and UWB: one attempt per robot, mount and tagged picker; `simulate` fills the model's fields.
-  auto tagSensor = [&](double stamp, const std::vector<SensorMount2D>& mounts, const std::string PickerSpec::*tag,
-                       double tag_height, std::mt19937_64 SensorStreams::*stream, auto& readings, auto&& simulate) {
+  auto tagSensor = [&](double stamp, const std::vector<SensorMount2D>& mounts,
+                       const std::string PickerSpec::*tag, double tag_height,
+                       std::mt19937_64 SensorStreams::*stream, auto& readings, auto&& simulate) {
     using Reading = typename std::decay_t<decltype(readings)>::value_type;
     for (std::size_t r = 0; r < robots_.size(); ++r)
       for (const auto& m : mounts) {
@@ -298,15 +313,17 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
   };
   onTicks(rfid_tick_, config_.rfid.rate, time_, [&](double stamp) {
     if (!en.rfid) return;
-    tagSensor(stamp, layout.rfid_antennas, &PickerSpec::rfid_tag, config_.rfid.tag_height, &SensorStreams::rfid,
-              out.rfid, [&](double d, std::mt19937_64& rng, RfidRead& read) {
+    tagSensor(stamp, layout.rfid_antennas, &PickerSpec::rfid_tag, config_.rfid.tag_height,
+              &SensorStreams::rfid, out.rfid, [&](double d, std::mt19937_64& rng, RfidRead& read) {
                 return simulateRfidRead(config_.rfid, d, rng, read);
               });
   });
   onTicks(uwb_tick_, config_.uwb.rate, time_, [&](double stamp) {
     if (!en.uwb) return;
-    tagSensor(stamp, layout.uwb_anchors, &PickerSpec::uwb_tag, config_.uwb.tag_height, &SensorStreams::uwb, out.uwb,
-              [&](double d, std::mt19937_64& rng, UwbReading& u) { return simulateUwbRange(config_.uwb, d, rng, u); });
+    tagSensor(stamp, layout.uwb_anchors, &PickerSpec::uwb_tag, config_.uwb.tag_height, &SensorStreams::uwb,
+              out.uwb, [&](double d, std::mt19937_64& rng, UwbReading& u) {
+                return simulateUwbRange(config_.uwb, d, rng, u);
+              });
   });
   onTicks(camera_tick_, config_.camera.rate, time_, [&](double stamp) {
     if (!en.camera) return;
@@ -321,7 +338,8 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
         f.frame = m.frame;
         f.image_width = config_.camera.image_width;
         f.image_height = config_.camera.image_height;
-        f.boxes = simulateCamera(config_.camera, robots_[r].pose().compose(m.pose), m.z, positions, streams_[r]->camera);
+        f.boxes = simulateCamera(config_.camera, robots_[r].pose().compose(m.pose), m.z, positions,
+                                 streams_[r]->camera);
         out.camera.push_back(std::move(f));
       }
   });

@@ -114,7 +114,8 @@ LaneLayout::LaneLayout(const topology::TopologicalMap& map) {
     return a.lane < b.lane;
   });
   lanes_ = std::move(infos);
-  for (std::size_t i = 0; i < lanes_.size(); ++i) order_of_lane_[static_cast<std::size_t>(lanes_[i].lane)] = int(i);
+  for (std::size_t i = 0; i < lanes_.size(); ++i)
+    order_of_lane_[static_cast<std::size_t>(lanes_[i].lane)] = int(i);
 
   std::vector<double> gaps;
   for (std::size_t i = 1; i < lanes_.size(); ++i)
@@ -147,7 +148,8 @@ bool appendPath(const topology::TopologicalMap& map, std::vector<NodeIndex>& tou
 }  // namespace
 
 std::vector<NodeIndex> buildLaneTour(const topology::TopologicalMap& map, const LaneLayout& layout,
-                                     std::size_t start_lane, const std::vector<NodeIndex>& fallback_waypoints) {
+                                     std::size_t start_lane,
+                                     const std::vector<NodeIndex>& fallback_waypoints) {
   std::vector<NodeIndex> tour;
   if (!layout.empty()) {
     const auto& lanes = layout.lanes();
@@ -176,13 +178,18 @@ std::vector<NodeIndex> buildLaneTour(const topology::TopologicalMap& map, const 
     }
     if (tour.size() >= 2) {
       std::vector<NodeIndex> back = map.shortestPath(tour.back(), tour.front());
-      if (tour.back() == tour.front()) tour.pop_back();
-      else if (back.size() > 2) tour.insert(tour.end(), back.begin() + 1, back.end() - 1);
+      if (tour.back() == tour.front())
+        tour.pop_back();
+      else if (back.size() > 2)
+        tour.insert(tour.end(), back.begin() + 1, back.end() - 1);
     }
   }
   // A single-lane single-node tour: walk to a neighbour and back.
-  if (tour.size() == 1 && !map.neighbours(tour.front()).empty()) tour.push_back(map.neighbours(tour.front()).front());
-  if (tour.size() < 2) throw std::invalid_argument("buildLaneTour: the map cannot host a walking tour (fewer than two connected nodes)");
+  if (tour.size() == 1 && !map.neighbours(tour.front()).empty())
+    tour.push_back(map.neighbours(tour.front()).front());
+  if (tour.size() < 2)
+    throw std::invalid_argument(
+        "buildLaneTour: the map cannot host a walking tour (fewer than two connected nodes)");
   return tour;
 }
 

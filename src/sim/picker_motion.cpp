@@ -71,7 +71,8 @@ void SimulatedPicker::step(double dt) {
       reverse_ends = true;
     }
     if (len > 1e-9) state_.edge_fraction = std::min(1.0, state_.edge_fraction + move * speed / len);
-    state_.gait_phase = std::fmod(state_.gait_phase + 2.0 * M_PI * speed * move / params_.stride_length, 2.0 * M_PI);
+    state_.gait_phase =
+        std::fmod(state_.gait_phase + 2.0 * M_PI * speed * move / params_.stride_length, 2.0 * M_PI);
     time_ += move;
     remaining -= move;
     if (!reverse_ends && move >= to_node - 1e-12) arrive();

@@ -58,9 +58,13 @@ bool SimulatedRobot::atGoal() const {
   return at_ == *goal_ && path_.empty();
 }
 
-NodeIndex SimulatedRobot::currentNode() const { return moving_ ? to_ : at_; }
+NodeIndex SimulatedRobot::currentNode() const {
+  return moving_ ? to_ : at_;
+}
 
-NodeIndex SimulatedRobot::nearestNode() const { return map_->nearestNode(pose_.position()); }
+NodeIndex SimulatedRobot::nearestNode() const {
+  return map_->nearestNode(pose_.position());
+}
 
 void SimulatedRobot::plan() {
   path_.clear();
@@ -127,8 +131,9 @@ void SimulatedRobot::step(double dt) {
     }
     const double len = map_->distance(from_, to_);
     const double left = (1.0 - edge_fraction_) * len;
-    if (len > 1e-9) pose_.yaw = std::atan2(map_->position2d(to_).y() - map_->position2d(from_).y(),
-                                           map_->position2d(to_).x() - map_->position2d(from_).x());
+    if (len > 1e-9)
+      pose_.yaw = std::atan2(map_->position2d(to_).y() - map_->position2d(from_).y(),
+                             map_->position2d(to_).x() - map_->position2d(from_).x());
     if (left > remaining) {
       edge_fraction_ += remaining / len;
       remaining = 0.0;

@@ -34,8 +34,8 @@ double raySegment(const Eigen::Vector2d& origin, const Eigen::Vector2d& dir, con
   return r;
 }
 
-LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params, double stamp,
-                    std::mt19937_64& rng) {
+LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params,
+                    double stamp, std::mt19937_64& rng) {
   LaserScan scan;
   scan.stamp = stamp;
   scan.angle_min = params.angle_min;
@@ -44,8 +44,9 @@ LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const La
   scan.range_max = params.range_max;
   scan.scan_time = params.rate > 0.0 ? 1.0 / params.rate : 0.0;
   scan.sensor_pose = sensor_pose;
-  const int n = std::max(1, static_cast<int>(std::floor((params.angle_max - params.angle_min) /
-                                                       params.angle_increment + 1e-9)) + 1);
+  const int n = std::max(
+      1, static_cast<int>(std::floor((params.angle_max - params.angle_min) / params.angle_increment + 1e-9)) +
+             1);
   scan.angle_max = params.angle_min + (n - 1) * params.angle_increment;
   scan.ranges.assign(static_cast<std::size_t>(n), std::numeric_limits<float>::infinity());
   const Eigen::Vector2d o = sensor_pose.position();
@@ -58,15 +59,19 @@ LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const La
   // Tests the beams whose angle (relative to the sensor) lies in [lo, hi] (rad, any branch of the angle).
   auto castWindow = [&](double lo, double hi, auto&& hit) {
     for (double shift : {-2.0 * M_PI, 0.0, 2.0 * M_PI}) {
-      const int i0 = std::max(0, static_cast<int>(std::ceil((lo + shift - params.angle_min) / params.angle_increment)));
-      const int i1 = std::min(n - 1, static_cast<int>(std::floor((hi + shift - params.angle_min) / params.angle_increment)));
+      const int i0 =
+          std::max(0, static_cast<int>(std::ceil((lo + shift - params.angle_min) / params.angle_increment)));
+      const int i1 = std::min(
+          n - 1, static_cast<int>(std::floor((hi + shift - params.angle_min) / params.angle_increment)));
       for (int i = i0; i <= i1; ++i) {
         const double r = hit(dirs[static_cast<std::size_t>(i)]);
         if (r < best[static_cast<std::size_t>(i)]) best[static_cast<std::size_t>(i)] = r;
       }
     }
   };
-  auto relAngle = [&](const Eigen::Vector2d& v) { return std::remainder(std::atan2(v.y(), v.x()) - sensor_pose.yaw, 2.0 * M_PI); };
+  auto relAngle = [&](const Eigen::Vector2d& v) {
+    return std::remainder(std::atan2(v.y(), v.x()) - sensor_pose.yaw, 2.0 * M_PI);
+  };
   const double reach = params.range_max + 1.0;
   // Circles: only the beams inside each circle's angular extent.
   for (const auto& c : scene.circles) {
@@ -93,7 +98,7 @@ LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const La
     const double eps = params.range_noise_std > 0.0 ? noise(rng) : 0.0;
     if (!std::isfinite(r)) continue;
     r += eps;
-    if (r > params.range_max) continue;                 // +inf: no return in range
+    if (r > params.range_max) continue;  // +inf: no return in range
     if (r < params.range_min) {
       scan.ranges[static_cast<std::size_t>(i)] = -std::numeric_limits<float>::infinity();  // too close
       continue;
@@ -114,7 +119,8 @@ bool simulateRfidRead(const RfidParams& p, double distance, std::mt19937_64& rng
   // Fixed number of draws per attempt (determinism does not depend on read outcomes).
   const double draw = u(rng), rssi_noise = n(rng), phase_noise = n(rng);
   if (draw >= rfidReadProbability(p, distance)) return false;
-  out.rssi = p.rssi_1m - 10.0 * p.path_loss_exponent * std::log10(std::max(distance, 0.1)) + p.rssi_std * rssi_noise;
+  out.rssi =
+      p.rssi_1m - 10.0 * p.path_loss_exponent * std::log10(std::max(distance, 0.1)) + p.rssi_std * rssi_noise;
   out.has_phase = true;
   const double phase = 4.0 * M_PI * distance / p.wavelength + p.phase_std * phase_noise;
   out.phase = std::fmod(std::fmod(phase, 2.0 * M_PI) + 2.0 * M_PI, 2.0 * M_PI);
@@ -135,7 +141,9 @@ bool simulateUwbRange(const UwbParams& p, double distance, std::mt19937_64& rng,
   return true;
 }
 
-double CameraParams::fx() const { return 0.5 * image_width / std::tan(0.5 * hfov); }
+double CameraParams::fx() const {
+  return 0.5 * image_width / std::tan(0.5 * hfov);
+}
 
 std::vector<CameraBox> simulateCamera(const CameraParams& p, const Pose2D& camera_pose, double camera_z,
                                       const std::vector<Eigen::Vector2d>& positions, std::mt19937_64& rng) {

@@ -20,8 +20,8 @@ Setter set(T& field) {
   return [&field](const YAML::Node& n) { field = n.as<T>(); };
 }
 
-void applySection(const YAML::Node& node, const std::map<std::string, Setter>& keys, const std::string& source,
-                  const std::string& section) {
+void applySection(const YAML::Node& node, const std::map<std::string, Setter>& keys,
+                  const std::string& source, const std::string& section) {
   if (!node.IsMap()) throw std::runtime_error(source + ": '" + section + "' must be a mapping");
   for (const auto& kv : node) {
     const std::string key = kv.first.as<std::string>();
@@ -45,7 +45,8 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
   if (!root || root.IsNull()) return;
   if (root["sim"] && root.size() == 1) root = root["sim"];
   auto section = [&](std::map<std::string, Setter> keys, const std::string& name) {
-    return [keys = std::move(keys), name, &source](const YAML::Node& n) { applySection(n, keys, source, name); };
+    return
+        [keys = std::move(keys), name, &source](const YAML::Node& n) { applySection(n, keys, source, name); };
   };
   std::map<std::string, Setter> top{
       {"seed", set(c.seed)},
@@ -84,7 +85,8 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                          {"heading_deg", set(c.datum.heading_deg)}},
                         "datum")},
       {"robot_motion", section({{"speed", set(c.robot_motion.speed)},
-                                {"patrol", [&c](const YAML::Node& n) {
+                                {"patrol",
+                                 [&c](const YAML::Node& n) {
                                    c.robot_motion.patrol = parsePatrolPolicy(n.as<std::string>());
                                  }}},
                                "robot_motion")},

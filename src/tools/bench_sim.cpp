@@ -39,7 +39,8 @@ static void BM_RiseholmeNoLaser(benchmark::State& state) {
 BENCHMARK(BM_RiseholmeNoLaser);
 
 static void BM_PolytunnelAllSensors(benchmark::State& state) {
-  const auto map = topology::makePolytunnelMap(topology::polytunnelSpecWithNodes(static_cast<std::size_t>(state.range(0))));
+  const auto map = topology::makePolytunnelMap(
+      topology::polytunnelSpecWithNodes(static_cast<std::size_t>(state.range(0))));
   runSim(state, map, 1, true);
 }
 BENCHMARK(BM_PolytunnelAllSensors)->Arg(1000)->Arg(10000);

@@ -6,8 +6,8 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/GoalNode.h>
 #include <ros/ros.h>
-#include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include <map>
 #include <memory>

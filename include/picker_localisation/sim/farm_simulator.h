@@ -1,16 +1,17 @@
 // The farm simulator: pickers walking the lanes, their GNSS units, robots driving the graph and the robots'
-// sensors, on any topological map, stepped with explicit simulated time (no wall clock; runs as fast as the CPU
-// allows). ROS-free; the farm_sim node and the offline experiment runner both drive it.
+// sensors, on any topological map, stepped with explicit simulated time (no wall clock; runs as fast as the
+// CPU allows). ROS-free; the farm_sim node and the offline experiment runner both drive it.
 //
 // Determinism: one seed. Every random process owns a std::mt19937_64 seeded from (seed, stream) through
-// SplitMix64, where the stream names the process (picker i motion, picker i GNSS, robot r patrol, robot r laser,
+// SplitMix64, where the stream names the process (picker i motion, picker i GNSS, robot r patrol, robot r
+// laser,
 // ...). The same seed gives the same numbers, and switching a sensor off or changing the robots' goals does
 // not change the pickers' walks or their GNSS errors (so methods compared on one seed see the same pickers).
 //
 // Time: the simulator integrates with a fixed internal step `time_step`; step(dt) / advanceTo(t) run as many
 // internal steps as needed (the last one shortened to land exactly on t). Sensors fire on their own grids:
-// a sensor of rate f fires at t = k / f (k = 1, 2, ...) as soon as the simulated time reaches it, with the scene
-// as of the end of that internal step (stamp = k / f, error <= time_step).
+// a sensor of rate f fires at t = k / f (k = 1, 2, ...) as soon as the simulated time reaches it, with the
+// scene as of the end of that internal step (stamp = k / f, error <= time_step).
 #pragma once
 
 #include "picker_localisation/sim/gnss_model.h"
@@ -40,9 +41,9 @@ namespace sim {
 struct PickerSpec {
   std::string id;
   bool has_gnss = true;
-  std::string rfid_tag;     // "" none
-  std::string uwb_tag;      // "" none
-  int start_lane = -1;      // position in LaneLayout::lanes() to start in; -1: spread evenly (see FarmSimulator)
+  std::string rfid_tag;  // "" none
+  std::string uwb_tag;   // "" none
+  int start_lane = -1;   // position in LaneLayout::lanes() to start in; -1: spread evenly (see FarmSimulator)
 };
 
 struct SensorSwitches {
@@ -55,10 +56,10 @@ struct SensorSwitches {
 
 struct SimConfig {
   std::uint64_t seed = 1;
-  double time_step = 0.05;               // s, internal integration step
-  std::vector<PickerSpec> pickers;       // empty: three default pickers picker_1..3 (tags rfid_000<i>, uwb_000<i>)
+  double time_step = 0.05;          // s, internal integration step
+  std::vector<PickerSpec> pickers;  // empty: three default pickers picker_1..3 (tags rfid_000<i>, uwb_000<i>)
   std::size_t num_robots = 1;
-  std::vector<std::string> robot_ids;    // empty: robot_1 .. robot_k
+  std::vector<std::string> robot_ids;          // empty: robot_1 .. robot_k
   std::vector<std::string> robot_start_nodes;  // node names; empty / missing: spread over lane ends
   PickerMotionParams picker_motion;
   GnssNoiseParams gnss;
@@ -73,9 +74,9 @@ struct SimConfig {
   SensorSwitches enable;
 };
 
-// Overrides the fields present in a YAML mapping shaped like config/sim.yaml (sections seed, time_step, robots,
-// picker_motion, gnss, datum, robot_motion, laser, rfid, uwb, camera, clutter, enable). Unknown keys are an
-// error. Throws std::runtime_error with one line naming `source` and the key.
+// Overrides the fields present in a YAML mapping shaped like config/sim.yaml (sections seed, time_step,
+// robots, picker_motion, gnss, datum, robot_motion, laser, rfid, uwb, camera, clutter, enable). Unknown keys
+// are an error. Throws std::runtime_error with one line naming `source` and the key.
 void applySimConfigYaml(const YAML::Node& root, SimConfig& config, const std::string& source = "<yaml>");
 SimConfig loadSimConfig(const std::string& path);
 // PickerSpecs from config/pickers.yaml entries (first RFID tag, UWB tag, has_gnss = gnss_topic non-empty).

@@ -10,10 +10,11 @@
 //    N(0, drift_std^2), drift_std = 2.5 m (Table I gps_drift), correlation time drift_tau (default 300 s),
 //    started from its stationary distribution. Exact discretisation over dt:
 //      d <- a d + sqrt(1 - a^2) drift_std n,  a = exp(-dt / drift_tau),  n ~ N(0, 1).
-//  - blackouts (Table I gps_off): onsets form a Poisson process of rate 1 / blackout_mean_interval (default one
+//  - blackouts (Table I gps_off): onsets form a Poisson process of rate 1 / blackout_mean_interval (default
+//  one
 //    per 600 s of non-blackout time); each lasts U(blackout_min, blackout_max) = U(30, 60) s. During a
-//    blackout the fix has status NO_FIX and NaN lat/lon/alt (or no fix at all, `blackout_emits_no_fix` false).
-//    The drift keeps evolving through a blackout.
+//    blackout the fix has status NO_FIX and NaN lat/lon/alt (or no fix at all, `blackout_emits_no_fix`
+//    false). The drift keeps evolving through a blackout.
 // The reported covariance is diagonal with reported_std^2 on east/north and (2 reported_std)^2 on up.
 #pragma once
 
@@ -32,7 +33,7 @@ namespace sim {
 // GeodeticDatum, type local_cartesian): latitude, longitude (deg, WGS84, of the map origin), altitude (m),
 // heading_deg (deg: yaw of the map x axis counter-clockwise from East; 0 means map x = East, map y = North).
 struct MapDatum {
-  double latitude = 53.268;     // Riseholme campus, Lincoln (UK), approximately (as config/datum.yaml)
+  double latitude = 53.268;  // Riseholme campus, Lincoln (UK), approximately (as config/datum.yaml)
   double longitude = -0.524;
   double altitude = 0.0;
   double heading_deg = 0.0;
@@ -60,18 +61,18 @@ class MapProjection {
 };
 
 struct GnssNoiseParams {
-  double offset_min = 0.0;       // m, per-axis constant offset ~ U(offset_min, offset_max)
-  double offset_max = 3.5;       // m
-  double white_std = 0.1;        // m, per-axis white noise std
-  double drift_std = 2.5;        // m, stationary std of the Gauss-Markov drift per axis
-  double drift_tau = 300.0;      // s, correlation time of the drift
+  double offset_min = 0.0;                // m, per-axis constant offset ~ U(offset_min, offset_max)
+  double offset_max = 3.5;                // m
+  double white_std = 0.1;                 // m, per-axis white noise std
+  double drift_std = 2.5;                 // m, stationary std of the Gauss-Markov drift per axis
+  double drift_tau = 300.0;               // s, correlation time of the drift
   double blackout_mean_interval = 600.0;  // s, mean non-blackout time between blackout onsets
-  double blackout_min = 30.0;    // s, blackout duration ~ U(blackout_min, blackout_max)
-  double blackout_max = 60.0;    // s
-  bool blackout_emits_no_fix = true;  // during a blackout: a NO_FIX message (true) or nothing (false)
-  double rate = 1.0;             // Hz, fixes per second
-  double reported_std = 3.0;     // m, std written into the fix's covariance (what a phone would report)
-  double antenna_height = 1.0;   // m above the map plane (altitude = datum altitude + this)
+  double blackout_min = 30.0;             // s, blackout duration ~ U(blackout_min, blackout_max)
+  double blackout_max = 60.0;             // s
+  bool blackout_emits_no_fix = true;      // during a blackout: a NO_FIX message (true) or nothing (false)
+  double rate = 1.0;                      // Hz, fixes per second
+  double reported_std = 3.0;    // m, std written into the fix's covariance (what a phone would report)
+  double antenna_height = 1.0;  // m above the map plane (altitude = datum altitude + this)
 };
 
 // The error process of one picker's GNSS unit. Owns its generator.

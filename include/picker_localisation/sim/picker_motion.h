@@ -10,9 +10,9 @@
 //  - Optional dwell (picking): on arriving at a lane node the picker stops for Exp(mean dwell_mean) s
 //    (dwell_mean = 0 disables it; the default).
 //  - Reversal ("at any step, p_change chance of changing direction for t_reverse seconds"): a step is one
-//    arrival at a tour node. At each arrival while walking forward, with probability p_reverse the picker turns
-//    round and walks the tour backwards for t_reverse seconds (it keeps following the graph, through the
-//    headland if it gets there), then turns forward again. No reversal can start while one is running.
+//    arrival at a tour node. At each arrival while walking forward, with probability p_reverse the picker
+//    turns round and walks the tour backwards for t_reverse seconds (it keeps following the graph, through
+//    the headland if it gets there), then turns forward again. No reversal can start while one is running.
 #pragma once
 
 #include "picker_localisation/sim/sim_types.h"
@@ -26,29 +26,29 @@ namespace picker_localisation {
 namespace sim {
 
 struct PickerMotionParams {
-  double speed_mean = 0.5;   // m/s, mean walking speed while picking along a lane
-  double speed_std = 0.1;    // m/s
-  double speed_min = 0.2;    // m/s, truncation of the speed distribution
-  double speed_max = 1.0;    // m/s
-  double p_reverse = 0.1;    // probability of turning round at each node arrival (Table I p_reverse)
-  double t_reverse = 60.0;   // s walked backwards after turning round (Table I t_reverse)
-  double dwell_mean = 0.0;   // s, mean of the exponential stop at each lane node (0: no stops)
-  double leg_radius = 0.06;  // m, leg circle radius (for the laser ray cast)
-  double leg_spread = 0.2;   // m between the two legs' centres, across the heading
-  double stride_length = 0.6;  // m travelled per full gait cycle (two steps)
+  double speed_mean = 0.5;       // m/s, mean walking speed while picking along a lane
+  double speed_std = 0.1;        // m/s
+  double speed_min = 0.2;        // m/s, truncation of the speed distribution
+  double speed_max = 1.0;        // m/s
+  double p_reverse = 0.1;        // probability of turning round at each node arrival (Table I p_reverse)
+  double t_reverse = 60.0;       // s walked backwards after turning round (Table I t_reverse)
+  double dwell_mean = 0.0;       // s, mean of the exponential stop at each lane node (0: no stops)
+  double leg_radius = 0.06;      // m, leg circle radius (for the laser ray cast)
+  double leg_spread = 0.2;       // m between the two legs' centres, across the heading
+  double stride_length = 0.6;    // m travelled per full gait cycle (two steps)
   double step_amplitude = 0.15;  // m, max along-heading offset of a leg from the body centre while walking
 };
 
 struct PickerState {
-  Pose2D pose;                 // ground truth, map frame
-  double speed = 0.0;          // m/s, current walking speed (0 while dwelling)
+  Pose2D pose;                                        // ground truth, map frame
+  double speed = 0.0;                                 // m/s, current walking speed (0 while dwelling)
   topology::NodeIndex from = topology::kInvalidNode;  // edge being walked (from -> to, in walking direction)
   topology::NodeIndex to = topology::kInvalidNode;
   double edge_fraction = 0.0;  // [0, 1] along from -> to
   bool reversed = false;       // walking the tour backwards
   double reverse_until = 0.0;  // s, end of the current reversal
   bool dwelling = false;
-  double gait_phase = 0.0;     // rad
+  double gait_phase = 0.0;                                    // rad
   topology::NodeIndex nearest_node = topology::kInvalidNode;  // node nearest the true position
 };
 
@@ -84,7 +84,8 @@ class SimulatedPicker {
   PickerMotionParams params_;
   std::mt19937_64 rng_;
   double time_ = 0.0;
-  std::size_t tour_pos_ = 0;  // index in tour_ of state_.from when walking forward, of state_.to when reversed
+  std::size_t tour_pos_ =
+      0;  // index in tour_ of state_.from when walking forward, of state_.to when reversed
   double dwell_until_ = 0.0;
   double lane_speed_ = 0.5;
   PickerState state_;

@@ -2,10 +2,10 @@
 //
 // The robot moves at a constant `speed` along the shortest path (TopologicalMap::shortestPath, undirected
 // motion graph) to its goal, interpolating along edges; yaw is the direction of travel (kept when stopped).
-// A new goal can be set at any time: when the robot is on an edge it first drives to whichever endpoint of that
-// edge gives the shorter total way (distance along the edge + pathLength(endpoint, goal)), turning back on the
-// edge if that is shorter. A reached goal is kept: the robot waits on it until a new goal or clearGoal().
-// With no goal (never set, or cleared) the patrol policy chooses where to drive next:
+// A new goal can be set at any time: when the robot is on an edge it first drives to whichever endpoint of
+// that edge gives the shorter total way (distance along the edge + pathLength(endpoint, goal)), turning back
+// on the edge if that is shorter. A reached goal is kept: the robot waits on it until a new goal or
+// clearGoal(). With no goal (never set, or cleared) the patrol policy chooses where to drive next:
 //   kStay:    wait where it is;
 //   kLanes:   visit the lane ends in order (lanes()[0] entry, far, lanes()[1] far, entry, ... the serpentine,
 //             i.e. drive along every lane), cyclically; falls back to kRandom on maps without lanes;
@@ -29,7 +29,7 @@ enum class PatrolPolicy { kStay, kLanes, kRandom };
 PatrolPolicy parsePatrolPolicy(const std::string& name);
 
 struct RobotMotionParams {
-  double speed = 1.0;                      // m/s along edges
+  double speed = 1.0;  // m/s along edges
   PatrolPolicy patrol = PatrolPolicy::kLanes;
 };
 

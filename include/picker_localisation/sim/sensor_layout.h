@@ -1,8 +1,8 @@
 // Where a simulated robot's sensors sit on its base. The defaults mirror config/robot/thorvald.urdf.in (a
-// Thorvald-like 1.5 m x 1.4 m base; two 2D lasers at opposite corners facing out diagonally; two RFID antennas
-// facing the lanes on either side; two cameras and three UWB anchors as in seed 004 Table 1). The lead may fill
-// it from the URDF (robot::RobotDescription); frame names are the URDF link names without the robot prefix.
-// ROS-free.
+// Thorvald-like 1.5 m x 1.4 m base; two 2D lasers at opposite corners facing out diagonally; two RFID
+// antennas facing the lanes on either side; two cameras and three UWB anchors as in seed 004 Table 1). The
+// lead may fill it from the URDF (robot::RobotDescription); frame names are the URDF link names without the
+// robot prefix. ROS-free.
 #pragma once
 
 #include "picker_localisation/sim/sim_types.h"
@@ -14,9 +14,9 @@ namespace picker_localisation {
 namespace sim {
 
 struct SensorMount2D {
-  std::string frame;   // link name without the "<robot_id>/" prefix
-  Pose2D pose;         // in base_link, m / rad
-  double z = 0.0;      // height above ground, m
+  std::string frame;  // link name without the "<robot_id>/" prefix
+  Pose2D pose;        // in base_link, m / rad
+  double z = 0.0;     // height above ground, m
 };
 
 struct RobotSensorLayout {
