@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
@@ -586,4 +587,44 @@ TEST(UwbRanging, PdoaDirectAndAsBearing) {
   ASSERT_EQ(out.size(), 1u);
   EXPECT_NEAR(out[0].position->x(), -1.0, 0.3);
   EXPECT_NEAR(out[0].position->y(), 5.0, 0.3);
+}
+
+// A person walking at 0.21 m/s (seed 004 Sec. 5) 3-6 m from a still robot, UWB ranges with 0.1 m Gaussian
+// noise from the three anchors at 10 Hz, for 60 s (seeded). Mean error with UWB only and with a camera
+// bearing (0.03 rad noise): the RHF must track, and the bearing must reduce the angular (tangential) error
+// (seed 004 reports a 66.67 % reduction of the angular error with its anchor layout and camera).
+TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
+  double mean_err[2] = {0.0, 0.0}, mean_tan[2] = {0.0, 0.0};
+  for (int use_cam = 0; use_cam < 2; ++use_cam) {
+    std::mt19937_64 rng(42);
+    std::normal_distribution<double> range_noise(0.0, 0.1), bearing_noise(0.0, 0.03);
+    RangeHistogramFilter rhf;
+    int n = 0;
+    for (int i = 0; i < 600; ++i) {
+      const double t = 0.1 * i;
+      const double phi = 0.21 * t / 4.5;  // circle of radius 4.5 m at 0.21 m/s
+      const Eigen::Vector2d person(4.5 * std::cos(phi), 4.5 * std::sin(phi));
+      std::vector<RangeMeasurement> ranges;
+      for (const auto& a : kAnchors) ranges.push_back({a, (person - a).norm() + range_noise(rng), 0.01});
+      std::vector<BearingMeasurement> bearings;
+      if (use_cam) bearings.push_back({Eigen::Vector2d::Zero(), std::atan2(person.y(), person.x()) + bearing_noise(rng), 0.03});
+      auto e = rhf.update(t, ranges, bearings);
+      ASSERT_TRUE(e.has_value());
+      if (i < 20) continue;  // settle
+      const Eigen::Vector2d d = e->position - person;
+      const Eigen::Vector2d tangent(-std::sin(phi), std::cos(phi));
+      mean_err[use_cam] += d.norm();
+      mean_tan[use_cam] += std::abs(d.dot(tangent)) / 4.5;  // rad
+      ++n;
+    }
+    mean_err[use_cam] /= n;
+    mean_tan[use_cam] /= n;
+  }
+  std::printf("RHF simulated walk: mean error UWB %.3f m (angular %.4f rad), UWB+camera %.3f m (angular %.4f rad)\n",
+              mean_err[0], mean_tan[0], mean_err[1], mean_tan[1]);
+  RecordProperty("mean_error_uwb_m", std::to_string(mean_err[0]));
+  RecordProperty("mean_error_uwb_camera_m", std::to_string(mean_err[1]));
+  EXPECT_LT(mean_err[0], 0.5);
+  EXPECT_LT(mean_err[1], 0.2);
+  EXPECT_LT(mean_tan[1], 0.75 * mean_tan[0]);  // measured: 0.036 -> 0.022 rad (-38 %)
 }
