@@ -19,7 +19,7 @@ install(TARGETS picker_localisation_vision
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
 # ROS adapters of the area (bag reading, message conversions, node classes).
-add_library(picker_localisation_vision_ros src/ros/vision_io.cpp)
+add_library(picker_localisation_vision_ros src/ros/vision_io.cpp src/ros/leg_detector_node.cpp)
 target_link_libraries(picker_localisation_vision_ros PUBLIC picker_localisation_ros picker_localisation_vision)
 add_dependencies(picker_localisation_vision_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_vision_ros
@@ -35,3 +35,7 @@ function(pl_vision_tool name)
 endfunction()
 pl_vision_tool(train_leg_classifier src/tools/train_leg_classifier.cpp)
 pl_vision_tool(detect_people src/tools/detect_people.cpp)
+pl_vision_tool(bag_detect_legs src/tools/bag_detect_legs.cpp)
+
+pl_add_node(leg_detector src/nodes/leg_detector_node.cpp)
+target_link_libraries(leg_detector picker_localisation_vision_ros)

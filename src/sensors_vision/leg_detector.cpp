@@ -7,6 +7,12 @@
 namespace picker_localisation {
 namespace sensors {
 
+bool isLegCandidate(const ScanCluster& cluster, const LegDetectorOptions& options) {
+  if (cluster.points.empty()) return false;
+  return cluster.centroid().norm() <= options.max_leg_range &&
+         (cluster.points.back() - cluster.points.front()).norm() <= options.max_leg_width;
+}
+
 std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOptions& options) {
   std::vector<std::tuple<double, int, int>> pairs;
   for (std::size_t a = 0; a < legs.size(); ++a)
@@ -51,10 +57,8 @@ LegDetection LegDetector::detect(const LaserScanData& scan) const {
   std::vector<LegFeatures> features;
   std::vector<std::size_t> candidates;
   for (std::size_t i = 0; i < out.clusters.size(); ++i) {
-    const auto& c = out.clusters[i];
-    const auto f = LegFeatures::compute(c, &scan);
-    if (f.values[11] > options_.max_leg_range || f.values[3] > options_.max_leg_width) continue;
-    features.push_back(f);
+    if (!isLegCandidate(out.clusters[i], options_)) continue;
+    features.push_back(LegFeatures::compute(out.clusters[i], &scan));
     candidates.push_back(i);
   }
   const auto prob = classifier_->legProbability(features);

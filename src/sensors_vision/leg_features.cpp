@@ -41,7 +41,6 @@ LegFeatures LegFeatures::compute(const ScanCluster& cluster, const LaserScanData
   LegFeatures f;
   const auto& pts = cluster.points;
   const std::size_t n = pts.size();
-  f.values[0] = static_cast<float>(n);
   if (n == 0) return f;
   const Eigen::Vector2d c = cluster.centroid();
 
@@ -52,32 +51,32 @@ LegFeatures LegFeatures::compute(const ScanCluster& cluster, const LaserScanData
     xs.push_back(p.x());
     ys.push_back(p.y());
   }
-  f.values[1] = static_cast<float>(std::sqrt(var / static_cast<double>(n)));
+  f.values[0] = static_cast<float>(std::sqrt(var / static_cast<double>(n)));
 
   const Eigen::Vector2d med(median(xs), median(ys));
   double mad = 0.0;
   for (const auto& p : pts) mad += (p - med).norm();
-  f.values[2] = static_cast<float>(mad / static_cast<double>(n));
+  f.values[1] = static_cast<float>(mad / static_cast<double>(n));
 
-  f.values[3] = static_cast<float>((pts.back() - pts.front()).norm());
+  f.values[2] = static_cast<float>((pts.back() - pts.front()).norm());
 
   // Linearity: mean squared distance to the total least-squares line = smallest covariance eigenvalue.
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
   for (const auto& p : pts) cov += (p - c) * (p - c).transpose();
   cov /= static_cast<double>(n);
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-  f.values[4] = static_cast<float>(std::max(0.0, eig.eigenvalues()(0)));
+  f.values[3] = static_cast<float>(std::max(0.0, eig.eigenvalues()(0)));
 
   Eigen::Vector2d centre;
   double radius = 0.0;
   if (fitCircle(pts, centre, radius)) {
     double res = 0.0;
     for (const auto& p : pts) res += std::pow(radius - (p - centre).norm(), 2);
-    f.values[5] = static_cast<float>(res / static_cast<double>(n));
-    f.values[6] = static_cast<float>(std::min(radius, 10.0));  // a straight segment fits a huge circle
+    f.values[4] = static_cast<float>(res / static_cast<double>(n));
+    f.values[5] = static_cast<float>(std::min(radius, 10.0));  // a straight segment fits a huge circle
   } else {
-    f.values[5] = 0.0f;
-    f.values[6] = 10.0f;
+    f.values[4] = 0.0f;
+    f.values[5] = 10.0f;
   }
 
   std::vector<double> steps;
@@ -86,35 +85,33 @@ LegFeatures LegFeatures::compute(const ScanCluster& cluster, const LaserScanData
     steps.push_back((pts[i] - pts[i - 1]).norm());
     length += steps.back();
   }
-  f.values[7] = static_cast<float>(length);
+  f.values[6] = static_cast<float>(length);
   if (!steps.empty()) {
     const double mean = length / static_cast<double>(steps.size());
     double sv = 0.0;
     for (double s : steps) sv += (s - mean) * (s - mean);
-    f.values[8] = static_cast<float>(std::sqrt(sv / static_cast<double>(steps.size())));
+    f.values[7] = static_cast<float>(std::sqrt(sv / static_cast<double>(steps.size())));
   }
 
-  // Menger curvature of consecutive triples and the mean inscribed angle (angle at each interior point
-  // between the rays to the first and the last point).
-  double curvature = 0.0, angle = 0.0;
-  int triples = 0, interior = 0;
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const Eigen::Vector2d a = pts[i - 1], b = pts[i], d = pts[i + 1];
+  // Curvature: Menger curvature of the first, middle and last point (consecutive triples are dominated by range
+  // noise when the points are dense, i.e. close to the sensor); mean inscribed angle: angle at each interior
+  // point between the rays to the first and the last point.
+  double angle = 0.0;
+  int interior = 0;
+  if (n >= 3) {
+    const Eigen::Vector2d a = pts.front(), b = pts[n / 2], d = pts.back();
     const double ab = (b - a).norm(), bd = (d - b).norm(), ad = (d - a).norm();
     const double cross = std::abs((b - a).x() * (d - a).y() - (b - a).y() * (d - a).x());
-    if (ab * bd * ad > 1e-12) {
-      curvature += 2.0 * cross / (ab * bd * ad);
-      ++triples;
-    }
-    const Eigen::Vector2d u = pts.front() - b, v = pts.back() - b;
+    f.values[8] = ab * bd * ad > 1e-12 ? static_cast<float>(2.0 * cross / (ab * bd * ad)) : 0.0f;
+  }
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const Eigen::Vector2d u = pts.front() - pts[i], v = pts.back() - pts[i];
     if (u.norm() > 1e-9 && v.norm() > 1e-9) {
       angle += std::acos(std::clamp(u.dot(v) / (u.norm() * v.norm()), -1.0, 1.0));
       ++interior;
     }
   }
-  f.values[9] = triples ? static_cast<float>(curvature / triples) : 0.0f;
-  f.values[10] = interior ? static_cast<float>(angle / interior) : 0.0f;
-  f.values[11] = static_cast<float>(c.norm());
+  f.values[9] = interior ? static_cast<float>(angle / interior) : 0.0f;
 
   if (scan != nullptr && !cluster.ranges.empty()) {
     const std::size_t first = cluster.first_beam, last = cluster.first_beam + n - 1;
@@ -124,16 +121,15 @@ LegFeatures LegFeatures::compute(const ScanCluster& cluster, const LaserScanData
       occluded = true;
     if (last + 1 < scan->ranges.size() && scan->validRange(last + 1) && scan->ranges[last + 1] < cluster.ranges.back())
       occluded = true;
-    f.values[12] = occluded ? 1.0f : 0.0f;
+    f.values[10] = occluded ? 1.0f : 0.0f;
   }
   return f;
 }
 
 std::string LegFeatures::name(int i) {
-  static const char* names[kCount] = {"points",    "std_dev",        "median_abs_dev", "width",
-                                      "linearity", "circularity",    "radius",         "boundary_length",
-                                      "boundary_regularity", "mean_curvature", "inscribed_angle",
-                                      "distance",  "occluded"};
+  static const char* names[kCount] = {"std_dev",         "median_abs_dev",      "width",     "linearity",
+                                      "circularity",     "radius",              "boundary_length",
+                                      "boundary_regularity", "curvature",       "inscribed_angle", "occluded"};
   return (i >= 0 && i < kCount) ? names[i] : "";
 }
 

@@ -7,21 +7,13 @@
 
 namespace picker_localisation {
 namespace sensors {
-namespace {
-
-bool passesGates(const LegFeatures& f, const LegDetectorOptions& options) {
-  return f.values[11] <= options.max_leg_range && f.values[3] <= options.max_leg_width;
-}
-
-}  // namespace
-
 void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<LaserScanData>& negatives,
                             const LegDetectorOptions& options, double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels) {
   for (const auto& ls : positives) {
     for (const auto& c : segmentScan(ls.scan, options.segmentation)) {
+      if (!isLegCandidate(c, options)) continue;
       const auto f = LegFeatures::compute(c, &ls.scan);
-      if (!passesGates(f, options)) continue;
       const Eigen::Vector2d centre = c.centroid();
       double nearest = std::numeric_limits<double>::infinity();
       for (const auto& l : ls.legs) nearest = std::min(nearest, (l - centre).norm());
@@ -36,9 +28,8 @@ void collectTrainingSamples(const std::vector<LabelledScan>& positives, const st
   }
   for (const auto& scan : negatives)
     for (const auto& c : segmentScan(scan, options.segmentation)) {
-      const auto f = LegFeatures::compute(c, &scan);
-      if (!passesGates(f, options)) continue;
-      samples.push_back(f);
+      if (!isLegCandidate(c, options)) continue;
+      samples.push_back(LegFeatures::compute(c, &scan));
       labels.push_back(0);
     }
 }

@@ -1,12 +1,13 @@
 // Trains the leg classifier from the labelled leg_tracker bags and writes the OpenCV model file.
-//   train_leg_classifier --data DIR --out config/leg_classifier.yml [--sweep]
-// (--sweep prints held-out recall / precision / false legs per scan for thresholds 0.1..0.9)
+//   train_leg_classifier --data DIR --out config/leg_classifier.yml [--sweep] [--features F.csv]
+// (--features writes every training / held-out feature vector; --sweep prints held-out recall / precision / false legs per scan for thresholds 0.1..0.9)
 // DIR holds positive_{1..4}_extracted.bag and negative_2.bag. Split (fixed, see leg_training.h): positives 1-3
 // and the first two thirds of negative_2 train; positive_4 and the last third of negative_2 are held out and
 // evaluated here (and in test_leg_detector_data).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <string>
 
 #include "picker_localisation/ros/vision_io.h"
@@ -17,7 +18,7 @@ using namespace picker_localisation;
 constexpr double kUnlabelledNegativeDistance = 0.5;
 
 int main(int argc, char** argv) {
-  std::string data, out;
+  std::string data, out, dump;
   double hit = 0.15;
   bool sweep = false;
   for (int i = 1; i < argc; i += 2) {
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
       --i;
     } else if (i + 1 < argc && !std::strcmp(argv[i], "--data")) data = argv[i + 1];
     else if (i + 1 < argc && !std::strcmp(argv[i], "--out")) out = argv[i + 1];
+    else if (i + 1 < argc && !std::strcmp(argv[i], "--features")) dump = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown option %s\n", argv[i]);
       return 2;
@@ -56,6 +58,24 @@ int main(int argc, char** argv) {
     std::printf("training: %zu positive and %zu negative clusters (%zu + %zu scans)\n", npos, labels.size() - npos,
                 train_pos.size(), train_neg.size());
     auto classifier = std::make_shared<sensors::LegClassifier>();
+    if (!dump.empty()) {
+      std::ofstream csv(dump);
+      csv << "set,label";
+      for (int k = 0; k < sensors::LegFeatures::kCount; ++k) csv << ',' << sensors::LegFeatures::name(k);
+      csv << '\n';
+      auto write = [&](const char* set, const std::vector<sensors::LegFeatures>& f, const std::vector<int>& l) {
+        for (std::size_t i = 0; i < f.size(); ++i) {
+          csv << set << ',' << l[i];
+          for (float v : f[i].values) csv << ',' << v;
+          csv << '\n';
+        }
+      };
+      write("train", samples, labels);
+      std::vector<sensors::LegFeatures> ts;
+      std::vector<int> tl;
+      sensors::collectTrainingSamples(test_pos, test_neg, options, hit, kUnlabelledNegativeDistance, ts, tl);
+      write("test", ts, tl);
+    }
     sensors::LegClassifierTrainingOptions topt;
     classifier->train(samples, labels, topt);
     classifier->save(out);

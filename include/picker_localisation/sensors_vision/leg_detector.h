@@ -34,13 +34,16 @@ struct LegDetection {
 
 struct LegDetectorOptions {
   SegmentationOptions segmentation;
-  double leg_threshold = 0.5;          // minimum leg probability for a cluster to be a leg
+  double leg_threshold = 0.6;          // minimum leg probability for a cluster to be a leg
   double max_leg_range = 8.0;          // clusters farther from the sensor are ignored, m
   double max_leg_width = 0.5;          // clusters wider than this are never legs, m
   double max_pair_distance = 0.7;      // two legs closer than this may be one person, m
   bool single_leg_people = true;       // an unpaired leg is a person (other leg occluded) ...
   double single_leg_factor = 0.5;      // ... with its confidence scaled by this factor
 };
+
+// Range and width gates applied before classification: clusters outside them are never legs.
+bool isLegCandidate(const ScanCluster& cluster, const LegDetectorOptions& options);
 
 // Pairs legs into people: greedy by increasing distance, each leg used once, pairs closer than
 // max_pair_distance; a pair's position is the midpoint and its confidence the mean leg probability.

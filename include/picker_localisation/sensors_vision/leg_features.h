@@ -11,15 +11,17 @@ namespace picker_localisation {
 namespace sensors {
 
 struct LegFeatures {
-  static constexpr int kCount = 13;
+  // Shape only: the number of points and the distance from the sensor are left out on purpose (they depend on
+  // the scanner's angular resolution and on where people happened to stand in the recordings; with them the
+  // forest generalised worse to the held-out recording and would not transfer to other lasers).
+  static constexpr int kCount = 11;
   // Order of values():
-  //  0 number of points               1 std. deviation from the centroid, m
-  //  2 mean absolute deviation from the median point, m    3 width (first-to-last point), m
-  //  4 linearity (residual of the total least-squares line), m^2   5 circularity (residual of the circle fit), m^2
-  //  6 radius of the fitted circle, m 7 boundary length (sum of consecutive distances), m
-  //  8 boundary regularity (std. dev. of consecutive distances), m  9 mean curvature (Menger), 1/m
-  // 10 mean inscribed angle, rad      11 distance of the centroid from the sensor, m
-  // 12 occluded flag: a neighbouring beam is nearer than the cluster edge (0/1)
+  //  0 std. deviation from the centroid, m      1 mean absolute deviation from the median point, m
+  //  2 width (first-to-last point), m            3 linearity (residual of the total least-squares line), m^2
+  //  4 circularity (residual of the circle fit), m^2   5 radius of the fitted circle, m
+  //  6 boundary length (sum of consecutive distances), m  7 boundary regularity (std. dev. of those), m
+  //  8 curvature (Menger, first/middle/last point), 1/m  9 mean inscribed angle, rad
+  // 10 occluded flag: a neighbouring beam is nearer than the cluster edge (0/1)
   std::array<float, kCount> values{};
 
   static LegFeatures compute(const ScanCluster& cluster, const LaserScanData* scan = nullptr);

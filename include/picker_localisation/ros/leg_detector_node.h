@@ -1,0 +1,72 @@
+// ROS adapter of the leg detector (sensors_vision area): LaserScan topic(s) and optionally a PointCloud2 ->
+// people in the fixed (map) frame -> PersonDetectionArray on `people` + one non-identifying Observation per
+// person on /observations. Fusion with a camera when ~detections_topic is set (seed 003 Algorithm 4).
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <picker_localisation/BearingDetectionArray.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/sensors_vision/cloud3d_person_detector.h"
+#include "picker_localisation/sensors_vision/cluster_tracker.h"
+#include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
+#include "picker_localisation/topology/topological_map.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+class LegDetectorNode {
+ public:
+  LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+  bool ok() const { return ok_; }
+
+ private:
+  struct PersonCandidate {
+    Eigen::Vector2d position;  // fixed frame
+    double confidence;
+    std::string sensor;
+  };
+  void scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg);
+  void cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg);
+  void detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg);
+  void cameraInfoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg);
+  bool lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
+              Eigen::Isometry3d& out);
+  // Tracks, fuses and publishes the people of one scan / cloud (positions in the fixed frame).
+  void publishPeople(const ros::Time& stamp, std::vector<PersonCandidate> people);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+  ros::NodeHandle nh_, pnh_;
+  bool ok_ = false;
+  std::string fixed_frame_ = "map", robot_id_;
+  double tf_timeout_ = 0.1, position_sigma_ = 0.3, fusion_max_age_ = 0.5, cone_half_width_ = 0.1;
+  bool require_confirmed_ = true;
+  std::unique_ptr<sensors::LegDetector> legs_;
+  sensors::Cloud3dPersonDetector cloud_detector_;
+  sensors::ClusterTracker tracker_;
+  sensors::LidarCameraFusion fusion_;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  std::vector<ros::Subscriber> subs_;
+  ros::Publisher people_pub_, obs_pub_;
+  picker_localisation::BearingDetectionArray::ConstPtr last_detections_;
+  sensor_msgs::CameraInfo::ConstPtr camera_info_;
+  diagnostic_updater::Updater diagnostics_;
+  std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
+              camera_frames_ = 0, fused_ = 0;
+  ros::Time last_input_;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

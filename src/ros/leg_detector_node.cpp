@@ -1,0 +1,258 @@
+#include "picker_localisation/ros/leg_detector_node.h"
+
+#include <pcl_conversions/pcl_conversions.h>
+#include <picker_localisation/PersonDetectionArray.h>
+#include <ros/package.h>
+#include <Eigen/Geometry>
+
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/vision_io.h"
+#include "picker_localisation/sensors_vision/person_box_detector.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
+  pnh_.param("fixed_frame", fixed_frame_, fixed_frame_);
+  pnh_.param("robot_id", robot_id_, robot_id_);
+  pnh_.param("tf_timeout", tf_timeout_, tf_timeout_);
+  pnh_.param("position_sigma", position_sigma_, position_sigma_);
+  pnh_.param("require_confirmed", require_confirmed_, require_confirmed_);
+  pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
+  pnh_.param("cone_half_width", cone_half_width_, cone_half_width_);
+
+  sensors::LegDetectorOptions lo;
+  pnh_.param("leg_threshold", lo.leg_threshold, lo.leg_threshold);
+  pnh_.param("max_leg_range", lo.max_leg_range, lo.max_leg_range);
+  pnh_.param("max_pair_distance", lo.max_pair_distance, lo.max_pair_distance);
+  pnh_.param("single_leg_people", lo.single_leg_people, lo.single_leg_people);
+  pnh_.param("jump_distance", lo.segmentation.jump_distance, lo.segmentation.jump_distance);
+  int min_points = static_cast<int>(lo.segmentation.min_points);
+  pnh_.param("min_cluster_points", min_points, min_points);
+  lo.segmentation.min_points = static_cast<std::size_t>(std::max(1, min_points));
+  sensors::ClusterTrackerOptions to;
+  pnh_.param("gate_distance", to.gate_distance, to.gate_distance);
+  pnh_.param("hits_to_confirm", to.hits_to_confirm, to.hits_to_confirm);
+  pnh_.param("misses_to_delete", to.misses_to_delete, to.misses_to_delete);
+  tracker_ = sensors::ClusterTracker(to);
+  sensors::LidarCameraFusionOptions fo;
+  pnh_.param("promote_after", fo.promote_after, fo.promote_after);
+  pnh_.param("demote_after", fo.demote_after, fo.demote_after);
+  pnh_.param("camera_weight", fo.camera_weight, fo.camera_weight);
+  fusion_ = sensors::LidarCameraFusion(fo);
+
+  std::string model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
+  pnh_.param("model_file", model, model);
+  try {
+    auto classifier = std::make_shared<sensors::LegClassifier>();
+    classifier->load(model);
+    legs_ = std::make_unique<sensors::LegDetector>(classifier, lo);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
+    return;
+  }
+
+  bool publish_observations = true;
+  pnh_.param("publish_observations", publish_observations, publish_observations);
+  if (publish_observations) {
+    double map_timeout = 30.0;
+    pnh_.param("map_timeout", map_timeout, map_timeout);
+    map_ = obtainMap(nh_, pnh_, map_timeout);
+    if (!map_) return;
+  }
+
+  std::vector<std::string> scan_topics{"scan"};
+  pnh_.param("scan_topics", scan_topics, scan_topics);
+  for (const auto& t : scan_topics) subs_.push_back(nh_.subscribe(t, 10, &LegDetectorNode::scanCallback, this));
+  std::string cloud_topic, detections_topic, camera_info_topic;
+  pnh_.param("cloud_topic", cloud_topic, cloud_topic);
+  pnh_.param("detections_topic", detections_topic, detections_topic);
+  pnh_.param("camera_info_topic", camera_info_topic, camera_info_topic);
+  if (!cloud_topic.empty()) subs_.push_back(nh_.subscribe(cloud_topic, 2, &LegDetectorNode::cloudCallback, this));
+  if (!detections_topic.empty())
+    subs_.push_back(nh_.subscribe(detections_topic, 5, &LegDetectorNode::detectionsCallback, this));
+  if (!camera_info_topic.empty())
+    subs_.push_back(nh_.subscribe(camera_info_topic, 1, &LegDetectorNode::cameraInfoCallback, this));
+  std::string observations_topic = "/observations";
+  pnh_.param("observations_topic", observations_topic, observations_topic);
+  people_pub_ = nh_.advertise<picker_localisation::PersonDetectionArray>("people", 10);
+  if (map_) obs_pub_ = nh_.advertise<picker_localisation::Observation>(observations_topic, 50);
+
+  diagnostics_.setHardwareID(robot_id_.empty() ? "leg_detector" : robot_id_);
+  diagnostics_.add("leg detector", this, &LegDetectorNode::diagnose);
+  ok_ = true;
+  ROS_INFO("%s: %zu scan topic(s), model %s, fixed frame %s%s", ros::this_node::getName().c_str(),
+           scan_topics.size(), model.c_str(), fixed_frame_.c_str(),
+           detections_topic.empty() ? "" : ", camera fusion on");
+}
+
+bool LegDetectorNode::lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
+                             Eigen::Isometry3d& out) {
+  try {
+    const auto t = tf_buffer_.lookupTransform(target, source, stamp, ros::Duration(tf_timeout_)).transform;
+    out = Eigen::Translation3d(t.translation.x, t.translation.y, t.translation.z) *
+          Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z);
+    return true;
+  } catch (const tf2::TransformException& e) {
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "%s: no transform %s -> %s at %.3f: %s (input dropped)", ros::this_node::getName().c_str(),
+                      source.c_str(), target.c_str(), stamp.toSec(), e.what());
+    return false;
+  }
+}
+
+void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) {
+  ++scans_;
+  last_input_ = msg->header.stamp;
+  const auto scan = toScanData(*msg);
+  if (scan.validCount() == 0) {
+    ++empty_scans_;
+    ROS_WARN_THROTTLE(5.0, "%s: scan on %s has no valid return (empty scan ignored)",
+                      ros::this_node::getName().c_str(), msg->header.frame_id.c_str());
+    return;
+  }
+  Eigen::Isometry3d tf;
+  if (!lookup(fixed_frame_, msg->header.frame_id, msg->header.stamp, tf)) return;
+  const auto detection = legs_->detect(scan);
+  std::vector<PersonCandidate> people;
+  for (const auto& p : detection.people) {
+    const Eigen::Vector3d q = tf * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
+    people.push_back({q.head<2>(), p.confidence, "lidar"});
+  }
+  publishPeople(msg->header.stamp, std::move(people));
+}
+
+void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
+  ++clouds_;
+  last_input_ = msg->header.stamp;
+  Eigen::Isometry3d tf;
+  if (!lookup(fixed_frame_, msg->header.frame_id, msg->header.stamp, tf)) return;
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  pcl::fromROSMsg(*msg, cloud);
+  if (cloud.empty()) {
+    ++empty_scans_;
+    ROS_WARN_THROTTLE(5.0, "%s: empty point cloud ignored", ros::this_node::getName().c_str());
+    return;
+  }
+  // The fixed frame's z is up: transform the cloud there before the ground removal.
+  const Eigen::Affine3f tff(tf.matrix().cast<float>());
+  for (auto& p : cloud.points) p.getVector3fMap() = tff * p.getVector3fMap();
+  std::vector<PersonCandidate> people;
+  for (const auto& p : cloud_detector_.detect(cloud)) people.push_back({p.centroid.head<2>(), p.confidence, "lidar3d"});
+  publishPeople(msg->header.stamp, std::move(people));
+}
+
+void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
+  ++camera_frames_;
+  last_detections_ = msg;
+}
+
+void LegDetectorNode::cameraInfoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg) { camera_info_ = msg; }
+
+void LegDetectorNode::publishPeople(const ros::Time& stamp, std::vector<PersonCandidate> people) {
+  std::vector<Eigen::Vector2d> positions;
+  for (const auto& p : people) positions.push_back(p.position);
+  const auto& tracks = tracker_.update(stamp.toSec(), positions);
+  std::vector<int> track_of(people.size(), -1);
+  std::vector<bool> confirmed(people.size(), false);
+  for (const auto& t : tracks)
+    if (t.updated && t.detection >= 0) {
+      track_of[t.detection] = t.id;
+      confirmed[t.detection] = t.confirmed;
+    }
+
+  // Camera fusion (Algorithm 4): the candidates in the camera's horizontal frame, one cone per box.
+  std::vector<sensors::FusedPerson> fused;
+  bool camera_frame = false;
+  if (last_detections_ && std::abs((last_detections_->header.stamp - stamp).toSec()) <= fusion_max_age_) {
+    Eigen::Isometry3d cam;
+    if (lookup(last_detections_->header.frame_id, fixed_frame_, last_detections_->header.stamp, cam)) {
+      std::vector<sensors::FusionCandidate> candidates;
+      for (std::size_t i = 0; i < people.size(); ++i) {
+        const Eigen::Vector3d q = cam * Eigen::Vector3d(people[i].position.x(), people[i].position.y(), 0.0);
+        candidates.push_back({q.head<2>(), track_of[i], people[i].confidence});
+      }
+      std::vector<sensors::BearingCone> cones;
+      for (const auto& d : last_detections_->detections) {
+        sensors::BearingCone cone{d.bearing, cone_half_width_, d.confidence};
+        if (camera_info_ && camera_info_->K[0] > 0.0 && d.box.width > 0) {
+          // Sec. 3.4.2: the box's min and max x columns bound the cone.
+          const sensors::CameraIntrinsics k{camera_info_->K[0], camera_info_->K[2], static_cast<int>(camera_info_->width)};
+          const double left = sensors::bearingFromColumn(d.box.x_offset, k);
+          const double right = sensors::bearingFromColumn(d.box.x_offset + d.box.width, k);
+          cone.half_width = 0.5 * std::abs(left - right);
+        }
+        cones.push_back(cone);
+      }
+      camera_frame = true;
+      fused = fusion_.fuse(candidates, cones, true);
+      last_detections_.reset();  // each camera frame is used once
+    }
+  }
+  if (!camera_frame) {
+    std::vector<sensors::FusionCandidate> candidates;
+    for (std::size_t i = 0; i < people.size(); ++i) candidates.push_back({people[i].position, track_of[i], people[i].confidence});
+    fused = fusion_.fuse(candidates, {}, false);
+  }
+
+  picker_localisation::PersonDetectionArray out;
+  out.header.stamp = stamp;
+  out.header.frame_id = fixed_frame_;
+  out.robot_id = robot_id_;
+  const double var = position_sigma_ * position_sigma_;
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    const bool camera = fused[i].camera_confirmed;
+    if (require_confirmed_ && !confirmed[i] && !camera) continue;  // hysteresis: spurious clusters stay out
+    picker_localisation::PersonDetection d;
+    d.position.x = people[i].position.x();
+    d.position.y = people[i].position.y();
+    d.covariance[0] = d.covariance[4] = var;
+    d.sensor = camera ? (people[i].sensor == "lidar3d" ? "lidar3d_camera" : "lidar_camera") : people[i].sensor;
+    d.confidence = fused[i].confidence;
+    d.track_id = track_of[i];
+    fused_ += camera ? 1 : 0;
+    out.detections.push_back(d);
+    if (map_) {
+      core::Observation obs;
+      obs.stamp = stamp.toSec();
+      // The TPF selects its gamma by sensor kind; a camera-confirmed cluster is still a LiDAR position.
+      obs.sensor = "lidar";
+      obs.robot_id = robot_id_;
+      obs.identifying = false;
+      obs.position = people[i].position;
+      // Camera-confirmed people are weighted higher: a tighter position covariance.
+      const double v = camera ? var * 0.5 : var;
+      obs.position_covariance = Eigen::Matrix2d::Identity() * v;
+      core::setGaussianLikelihood(obs, *map_, people[i].position, obs.position_covariance);
+      obs_pub_.publish(toMsg(obs, *map_, fixed_frame_));
+      ++observations_;
+    }
+  }
+  people_ += out.detections.size();
+  people_pub_.publish(out);
+}
+
+void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  if (scans_ + clouds_ == 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no scan received yet");
+  else if (tf_failures_ > 0 && tf_failures_ * 2 > scans_ + clouds_)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "most inputs dropped: missing tf");
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
+  stat.add("scans", scans_);
+  stat.add("clouds", clouds_);
+  stat.add("empty inputs", empty_scans_);
+  stat.add("tf failures (dropped)", tf_failures_);
+  stat.add("camera frames", camera_frames_);
+  stat.add("people published", people_);
+  stat.add("camera-confirmed people", fused_);
+  stat.add("observations published", observations_);
+  stat.add("live tracks", tracker_.tracks().size());
+  stat.add("last input stamp", last_input_.toSec());
+}
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation

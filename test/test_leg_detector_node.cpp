@@ -1,0 +1,141 @@
+// rostest of leg_detector: real scans of the held-out labelled bag (leg_tracker positive_4) are published with a
+// static map -> right_laser transform; the node must publish people near the labelled legs (in the map frame)
+// and non-identifying lidar Observations; an empty scan and a scan in a frame without tf must not kill it.
+#include <gtest/gtest.h>
+#include <picker_localisation/Observation.h>
+#include <picker_localisation/PersonDetectionArray.h>
+#include <ros/ros.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include <geometry_msgs/PoseArray.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+
+namespace {
+
+constexpr double kOffsetX = 14.0, kOffsetY = -20.0;  // map -> right_laser translation (near the first node)
+
+struct Recorder {
+  std::vector<picker_localisation::PersonDetectionArray> people;
+  std::vector<picker_localisation::Observation> observations;
+  void onPeople(const picker_localisation::PersonDetectionArray::ConstPtr& m) { people.push_back(*m); }
+  void onObservation(const picker_localisation::Observation::ConstPtr& m) { observations.push_back(*m); }
+};
+
+bool waitFor(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return done();
+}
+
+}  // namespace
+
+TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
+  ros::NodeHandle nh;
+  Recorder rec;
+  auto people_sub = nh.subscribe("people", 100, &Recorder::onPeople, &rec);
+  auto obs_sub = nh.subscribe("/observations", 100, &Recorder::onObservation, &rec);
+  auto pub = nh.advertise<sensor_msgs::LaserScan>("scan_front", 100);
+  tf2_ros::StaticTransformBroadcaster tfb;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = "map";
+  t.child_frame_id = "right_laser";
+  t.transform.translation.x = kOffsetX;
+  t.transform.translation.y = kOffsetY;
+  t.transform.rotation.w = 1.0;
+  tfb.sendTransform(t);
+  ASSERT_TRUE(waitFor([&] { return pub.getNumSubscribers() > 0 && people_sub.getNumPublishers() > 0; }, 30.0));
+
+  // The first 40 labelled scans, in order, at 10 Hz with fresh stamps.
+  rosbag::Bag bag(std::string(PL_SHARED_DATA) + "/leg_tracker/rosbags/training_scans_res=0.33/positive_4_extracted.bag");
+  rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/training_scan", "/leg_cluster_positions"}));
+  std::vector<sensor_msgs::LaserScan> scans;
+  std::vector<std::vector<std::pair<double, double>>> labels;
+  for (const auto& m : view) {
+    if (auto s = m.instantiate<sensor_msgs::LaserScan>()) scans.push_back(*s);
+    if (auto p = m.instantiate<geometry_msgs::PoseArray>()) {
+      labels.emplace_back();
+      for (const auto& pose : p->poses) labels.back().emplace_back(pose.position.x, pose.position.y);
+    }
+  }
+  ASSERT_GE(scans.size(), 40u);
+  ros::Time last_stamp;
+  for (std::size_t i = 0; i < 40; ++i) {
+    auto s = scans[i];
+    s.header.stamp = last_stamp = ros::Time::now();
+    s.header.frame_id = "right_laser";
+    pub.publish(s);
+    waitFor([] { return false; }, 0.1);
+  }
+  ASSERT_TRUE(waitFor([&] { return rec.people.size() >= 40; }, 10.0)) << rec.people.size() << " people messages";
+
+  // People: map frame, robot id, near a labelled leg of the scan (+ the tf offset), tracked.
+  std::size_t near = 0, total = 0;
+  for (std::size_t i = 0; i < rec.people.size() && i < 40; ++i) {
+    const auto& a = rec.people[i];
+    EXPECT_EQ(a.header.frame_id, "map");
+    EXPECT_EQ(a.robot_id, "robot_1");
+    for (const auto& d : a.detections) {
+      ++total;
+      EXPECT_GE(d.track_id, 0);
+      EXPECT_GT(d.confidence, 0.0);
+      EXPECT_LE(d.confidence, 1.0);
+      EXPECT_EQ(d.sensor, "lidar");
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& l : labels[i])
+        best = std::min(best, std::hypot(d.position.x - (l.first + kOffsetX), d.position.y - (l.second + kOffsetY)));
+      near += best < 0.5 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(near, 5u) << "people near the labelled legs: " << near << " of " << total;
+  // Observations: one per published person, non-identifying lidar likelihoods over map nodes.
+  ASSERT_TRUE(waitFor([&] { return rec.observations.size() >= total; }, 5.0));
+  EXPECT_EQ(rec.observations.size(), total);
+  for (const auto& o : rec.observations) {
+    EXPECT_EQ(o.sensor, "lidar");
+    EXPECT_FALSE(o.identifying);
+    EXPECT_TRUE(o.picker_id.empty());
+    EXPECT_EQ(o.robot_id, "robot_1");
+    EXPECT_EQ(o.header.frame_id, "map");
+    ASSERT_FALSE(o.nodes.empty());
+    EXPECT_EQ(o.nodes.size(), o.likelihood.size());
+    EXPECT_TRUE(std::isfinite(o.position.x));
+  }
+
+  // An empty scan (no returns) and a scan in a frame without tf: no output, no crash.
+  const std::size_t before = rec.people.size();
+  auto empty = scans[0];
+  empty.header.stamp = ros::Time::now();
+  empty.header.frame_id = "right_laser";
+  std::fill(empty.ranges.begin(), empty.ranges.end(), std::numeric_limits<float>::infinity());
+  pub.publish(empty);
+  auto orphan = scans[1];
+  orphan.header.stamp = ros::Time::now();
+  orphan.header.frame_id = "no_such_laser";
+  pub.publish(orphan);
+  waitFor([] { return false; }, 1.0);
+  EXPECT_EQ(rec.people.size(), before);
+  // Still alive: a good scan produces output again.
+  auto good = scans[40];
+  good.header.stamp = ros::Time::now();
+  good.header.frame_id = "right_laser";
+  pub.publish(good);
+  EXPECT_TRUE(waitFor([&] { return rec.people.size() > before; }, 5.0)) << "leg_detector stopped publishing";
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_leg_detector_node");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
