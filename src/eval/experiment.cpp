@@ -19,6 +19,8 @@
 #include "picker_localisation/eval/ukf_metric_tracker.h"
 #include "picker_localisation/topology/map_io.h"
 
+#include <yaml-cpp/yaml.h>
+
 // Components of other areas: each is compiled in only when its library is part of this build (the eval cmake
 // fragment defines PL_HAVE_<X> from the targets that exist), so a method needing a missing one is reported
 // unavailable instead of being faked.
@@ -33,6 +35,7 @@
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #endif
 #ifdef PL_HAVE_VISION
+#include "picker_localisation/sensors_vision/cluster_tracker.h"
 #include "picker_localisation/sensors_vision/leg_detector.h"
 #endif
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
@@ -197,6 +200,44 @@ sensors::GnssFix toIngestFix(const sim::GnssFix& f) {
   return g;
 }
 
+// The front-end options the ROS nodes load from config/gnss_ingest.yaml and config/rfid_ranging.yaml (keys that
+// only concern the node, such as topics and timeouts, are skipped).
+template <typename T>
+void readKey(const YAML::Node& y, const char* key, T& value) {
+  if (y[key]) value = y[key].as<T>();
+}
+
+sensors::GnssIngestOptions gnssOptions(const std::string& file) {
+  sensors::GnssIngestOptions o;
+  if (file.empty()) return o;
+  const YAML::Node y = YAML::LoadFile(file);
+  readKey(y, "default_sigma", o.default_sigma);
+  readKey(y, "min_sigma", o.min_sigma);
+  readKey(y, "cutoff_sigmas", o.cutoff_sigmas);
+  readKey(y, "max_nodes", o.max_nodes);
+  readKey(y, "velocity_window", o.velocity_window);
+  readKey(y, "max_speed", o.max_speed);
+  readKey(y, "jump_gate_sigmas", o.jump_gate_sigmas);
+  readKey(y, "jump_reset_count", o.jump_reset_count);
+  readKey(y, "blackout_timeout", o.blackout_timeout);
+  return o;
+}
+
+sensors::RfidModelOptions rfidOptions(const std::string& file) {
+  sensors::RfidModelOptions o;
+  if (file.empty()) return o;
+  const YAML::Node y = YAML::LoadFile(file);
+  readKey(y, "read_range", o.read_range);
+  readKey(y, "beam_half_angle", o.beam_half_angle);
+  readKey(y, "min_rssi", o.min_rssi);
+  readKey(y, "out_of_order_tolerance", o.out_of_order_tolerance);
+  readKey(y, "negative_information", o.negative_information);
+  readKey(y, "negative_window", o.negative_window);
+  readKey(y, "negative_period", o.negative_period);
+  readKey(y, "p_detect", o.p_detect);
+  return o;
+}
+
 sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
   sensors::DatumConfig c;
   c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
@@ -264,18 +305,22 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   // --- front-ends (GnssIngest uses the datum file as the gnss_ingest node does) ---------------------------
   const sensors::GeodeticDatum datum =
       datum_file.empty() ? datumOf(simulator.projection().datum()) : sensors::GeodeticDatum::load(datum_file);
+  const sensors::GnssIngestOptions gnss_options =
+      gnssOptions(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"));
   std::vector<PickerTrack> tracks(n);
   std::vector<core::PickerConfig> registry_entries;
   for (std::size_t i = 0; i < n; ++i) {
     const sim::PickerSpec& ps = simulator.pickerSpec(i);
     tracks[i].id = ps.id;
-    tracks[i].gnss = std::make_unique<sensors::GnssIngest>(ps.id, map, datum);
+    tracks[i].gnss = std::make_unique<sensors::GnssIngest>(ps.id, map, datum, gnss_options);
     registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag});
   }
   const core::PickerRegistry registry(registry_entries);
-  sensors::RfidObservationModel rfid_model(registry, map);
+  sensors::RfidObservationModel rfid_model(registry, map,
+                                          rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
   std::unique_ptr<sensors::LegDetector> legs;
+  sensors::ClusterTracker leg_tracks;  // as the leg_detector node: one tracker over both lasers, map frame
   if (spec.lidar) {
     auto classifier = std::make_shared<sensors::LegClassifier>();
     classifier->load(legModelPath(config));
@@ -379,8 +424,14 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         scan.range_max = s.range_max;
         scan.ranges = s.ranges;
         const sensors::LegDetection det = legs->detect(scan);
+        std::vector<Eigen::Vector2d> candidates;
+        for (const auto& p : det.people) candidates.push_back(s.sensor_pose.transform(p.position));
+        // leg_detector node (require_confirmed, its default): only people whose cluster track is confirmed
+        // (hit/miss hysteresis) become observations; spurious clusters stay out.
         std::vector<Eigen::Vector2d> people;
-        for (const auto& p : det.people) people.push_back(s.sensor_pose.transform(p.position));
+        for (const auto& t : leg_tracks.update(s.stamp, candidates))
+          if (t.updated && t.detection >= 0 && (t.confirmed || !config.require_confirmed))
+            people.push_back(candidates[static_cast<std::size_t>(t.detection)]);
         result.lidar_detections += people.size();
         if (spec.tracker == Tracker::kUkf) {
           ukf.addDetections(s.stamp, people);

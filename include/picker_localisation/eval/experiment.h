@@ -43,7 +43,9 @@ struct RunConfig {
   double duration = 600.0;         // simulated s (one tour of the Riseholme lanes at 0.5 m/s)
   double sample_period = 1.0;      // s between metric samples (per picker)
   double step = 0.1;               // s, simulator advance between event merges
-  double lidar_sigma = 0.3;        // m, std of the Gaussian node likelihood of a leg detection
+  double lidar_sigma = 0.3;        // m, std of the Gaussian node likelihood of a leg detection (leg_detector
+                                   // node ~position_sigma)
+  bool require_confirmed = true;   // leg_detector node ~require_confirmed: only confirmed cluster tracks
   double replan_period = 10.0;     // s, navigation policies re-plan at least this often
   // Configuration files shared with the ROS graph (farm_sim, gnss_ingest, tpf_tracker, ...), so the runner
   // and demo.launch simulate the same farm. "" = the package's config/<file> when it exists, else built-in
@@ -53,6 +55,8 @@ struct RunConfig {
   std::string sim_config;          // simulator, config/sim.yaml (seed, pickers, robots, switches set here)
   std::string datum_file;          // geodetic datum of simulator and GnssIngest, config/datum.yaml
   std::string pickers_file;        // pickers (the first 1 or 3 entries), config/pickers.yaml
+  std::string gnss_config;         // GnssIngest options, config/gnss_ingest.yaml
+  std::string rfid_config;         // RfidObservationModel options, config/rfid_ranging.yaml
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
 };
 
