@@ -19,7 +19,8 @@ install(TARGETS picker_localisation_vision
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
 # ROS adapters of the area (bag reading, message conversions, node classes).
-add_library(picker_localisation_vision_ros src/ros/vision_io.cpp src/ros/leg_detector_node.cpp)
+add_library(picker_localisation_vision_ros src/ros/vision_io.cpp src/ros/leg_detector_node.cpp
+  src/ros/camera_detector_node.cpp)
 target_link_libraries(picker_localisation_vision_ros PUBLIC picker_localisation_ros picker_localisation_vision)
 add_dependencies(picker_localisation_vision_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_vision_ros
@@ -39,3 +40,5 @@ pl_vision_tool(bag_detect_legs src/tools/bag_detect_legs.cpp)
 
 pl_add_node(leg_detector src/nodes/leg_detector_node.cpp)
 target_link_libraries(leg_detector picker_localisation_vision_ros)
+pl_add_node(camera_detector src/nodes/camera_detector_node.cpp)
+target_link_libraries(camera_detector picker_localisation_vision_ros)
