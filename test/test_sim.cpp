@@ -185,36 +185,68 @@ TEST(PickerMotion, StaysOnTheGraphAndInLanes) {
   EXPECT_GT(in_lane, steps * 0.7);
 }
 
-TEST(PickerMotion, ReversesWithTheConfiguredRate) {
+// Runs pickers for `seconds` each and returns (decisions, reversals, reversed time share, reversal
+// durations).
+struct ReversalStats {
+  std::size_t decisions = 0, reversals = 0, arrivals = 0;
+  double reversed_share = 0.0;
+  std::vector<double> durations;
+};
+ReversalStats runReversals(const PickerMotionParams& params, double seconds) {
   const auto map = polytunnel(6, 8);
   LaneLayout layout(map);
-  PickerMotionParams params;  // p_reverse 0.1, t_reverse 60 s
-  params.speed_mean = 1.0;
-  params.speed_min = 0.9;
-  params.speed_max = 1.1;
-  std::size_t arrivals = 0, reversals = 0;
-  std::vector<double> durations;
+  ReversalStats st;
+  double reversed_time = 0.0, total = 0.0;
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     SimulatedPicker picker(map, buildLaneTour(map, layout, 0), params, seed);
     bool was = false;
     double since = 0.0;
-    for (int k = 0; k < 40000; ++k) {  // 4000 s
+    for (int k = 0; k < static_cast<int>(seconds * 10); ++k) {
       picker.step(0.1);
       const bool rev = picker.state().reversed;
+      if (rev) reversed_time += 0.1;
+      total += 0.1;
       if (rev && !was) since = picker.time();
-      if (!rev && was) durations.push_back(picker.time() - since);
+      if (!rev && was) st.durations.push_back(picker.time() - since);
       was = rev;
     }
-    arrivals += picker.forwardArrivals();
-    reversals += picker.reversalsStarted();
+    st.decisions += picker.reversalDecisions();
+    st.reversals += picker.reversalsStarted();
+    st.arrivals += picker.forwardArrivals();
   }
-  ASSERT_GT(arrivals, 2000u);
-  const double rate = static_cast<double>(reversals) / arrivals;
-  const double sigma = std::sqrt(0.1 * 0.9 / arrivals);
-  EXPECT_NEAR(rate, 0.1, 4.0 * sigma);
-  ASSERT_GT(durations.size(), 20u);
-  // Every reversal lasts t_reverse (to the step resolution: it starts at an arrival inside a step).
-  for (double d : durations) EXPECT_NEAR(d, 60.0, 0.11);
+  st.reversed_share = reversed_time / total;
+  return st;
+}
+
+TEST(PickerMotion, ReversesWithTheConfiguredRate) {
+  PickerMotionParams params;  // p_reverse 0.1, t_reverse 60 s, one decision per 60 s of forward walking
+  const ReversalStats st = runReversals(params, 40000.0);
+  // Decisions: one per reverse_step of forward time.
+  EXPECT_NEAR(static_cast<double>(st.decisions), 5 * 40000.0 * (1.0 - st.reversed_share) / 60.0, 5.0);
+  ASSERT_GT(st.decisions, 2000u);
+  const double rate = static_cast<double>(st.reversals) / st.decisions;
+  EXPECT_NEAR(rate, 0.1, 4.0 * std::sqrt(0.1 * 0.9 / st.decisions));
+  // Share of time reversed: p t_rev / (reverse_step + p t_rev) = 6 / 66.
+  EXPECT_NEAR(st.reversed_share, 6.0 / 66.0, 0.015);
+  ASSERT_GT(st.durations.size(), 100u);
+  for (double d : st.durations) EXPECT_NEAR(d, 60.0, 0.11);  // to the step resolution
+
+  // Per-arrival decisions (reverse_step 0): the rate holds per forward node arrival.
+  params.reverse_step = 0.0;
+  const ReversalStats pa = runReversals(params, 4000.0);
+  EXPECT_EQ(pa.decisions, pa.arrivals);
+  ASSERT_GT(pa.arrivals, 1000u);
+  EXPECT_NEAR(static_cast<double>(pa.reversals) / pa.arrivals, 0.1, 4.0 * std::sqrt(0.09 / pa.arrivals));
+  for (double d : pa.durations) EXPECT_NEAR(d, 60.0, 0.11);
+}
+
+TEST(PickerMotion, MakesProgressThroughTheLanes) {
+  // With the default reversal model a picker walks through many lanes in an hour (net forward progress).
+  const auto map = polytunnel(6, 8);
+  LaneLayout layout(map);
+  SimulatedPicker picker(map, buildLaneTour(map, layout, 0), PickerMotionParams(), 21);
+  picker.step(3600.0);
+  EXPECT_GT(picker.lanesEntered(), 20u);
 }
 
 TEST(PickerMotion, SwitchesToTheAdjacentLaneAtLaneEnds) {

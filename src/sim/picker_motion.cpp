@@ -18,6 +18,8 @@ SimulatedPicker::SimulatedPicker(const topology::TopologicalMap& map, std::vecto
     if (n >= map.numNodes()) throw std::invalid_argument("SimulatedPicker: tour node out of range");
   if (!(params_.speed_min > 0.0) || params_.speed_max < params_.speed_min)
     throw std::invalid_argument("SimulatedPicker: need 0 < speed_min <= speed_max");
+  if (params_.reverse_step < 0.0) throw std::invalid_argument("SimulatedPicker: reverse_step must be >= 0");
+  next_decision_ = time_ + params_.reverse_step;
   lane_speed_ = drawSpeed();
   state_.from = tour_[0];
   state_.to = tour_[1];
@@ -55,27 +57,35 @@ void SimulatedPicker::step(double dt) {
       state_.speed = lane_speed_;
     }
     if (state_.reversed && time_ >= state_.reverse_until - 1e-12) {
-      // The reversal is over: turn round where the picker is.
+      // The reversal is over: turn round where the picker is; the next decision comes reverse_step later.
       state_.reversed = false;
       tour_pos_ = (tour_pos_ + N - 1) % N;
       std::swap(state_.from, state_.to);
       state_.edge_fraction = 1.0 - state_.edge_fraction;
+      next_decision_ = time_ + params_.reverse_step;
+    }
+    const bool timed = params_.reverse_step > 0.0;
+    if (timed && !state_.reversed && time_ >= next_decision_ - 1e-12) {
+      decideReversal();
+      next_decision_ = time_ + params_.reverse_step;
+      continue;
     }
     const double len = map_->distance(state_.from, state_.to);
     const double speed = lane_speed_;
     const double to_node = len > 1e-9 ? (1.0 - state_.edge_fraction) * len / speed : 0.0;
     double move = std::min(remaining, to_node);
-    bool reverse_ends = false;
-    if (state_.reversed && state_.reverse_until - time_ < move) {
-      move = std::max(0.0, state_.reverse_until - time_);
-      reverse_ends = true;
+    bool interrupted = false;  // stopped before the node by the end of a reversal or a decision time
+    const double until = state_.reversed ? state_.reverse_until : (timed ? next_decision_ : 1e300);
+    if (until - time_ < move) {
+      move = std::max(0.0, until - time_);
+      interrupted = true;
     }
     if (len > 1e-9) state_.edge_fraction = std::min(1.0, state_.edge_fraction + move * speed / len);
     state_.gait_phase =
         std::fmod(state_.gait_phase + 2.0 * M_PI * speed * move / params_.stride_length, 2.0 * M_PI);
     time_ += move;
     remaining -= move;
-    if (!reverse_ends && move >= to_node - 1e-12) arrive();
+    if (!interrupted && move >= to_node - 1e-12) arrive();
   }
   updatePose();
 }
@@ -95,25 +105,31 @@ void SimulatedPicker::arrive() {
     ++lanes_entered_;
     lane_speed_ = drawSpeed();
   }
-  // One "step" of the paper's walk: while walking forward, turn round with probability p_reverse.
-  if (!state_.reversed) {
-    std::bernoulli_distribution turn(std::clamp(params_.p_reverse, 0.0, 1.0));
-    if (turn(rng_)) {
-      state_.reversed = true;
-      state_.reverse_until = time_ + params_.t_reverse;
-      ++reversals_started_;
-    }
-  }
   state_.from = node;
   state_.to = state_.reversed ? tour_[(tour_pos_ + N - 1) % N] : tour_[(tour_pos_ + 1) % N];
   state_.edge_fraction = 0.0;
   state_.speed = lane_speed_;
+  if (params_.reverse_step <= 0.0) decideReversal();  // per-arrival decisions
   if (params_.dwell_mean > 0.0 && lane != topology::kNoLane) {
     std::exponential_distribution<double> d(1.0 / params_.dwell_mean);
     state_.dwelling = true;
     state_.speed = 0.0;
     dwell_until_ = time_ + d(rng_);
   }
+}
+
+void SimulatedPicker::decideReversal() {
+  if (state_.reversed) return;
+  ++reversal_decisions_;
+  std::bernoulli_distribution turn(std::clamp(params_.p_reverse, 0.0, 1.0));
+  if (!turn(rng_)) return;
+  // Turn round where the picker is (on a node or mid-edge).
+  state_.reversed = true;
+  state_.reverse_until = time_ + params_.t_reverse;
+  ++reversals_started_;
+  tour_pos_ = (tour_pos_ + 1) % tour_.size();
+  std::swap(state_.from, state_.to);
+  state_.edge_fraction = 1.0 - state_.edge_fraction;
 }
 
 void SimulatedPicker::updatePose() {

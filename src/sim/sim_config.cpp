@@ -60,6 +60,7 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                                  {"speed_max", set(c.picker_motion.speed_max)},
                                  {"p_reverse", set(c.picker_motion.p_reverse)},
                                  {"t_reverse", set(c.picker_motion.t_reverse)},
+                                 {"reverse_step", set(c.picker_motion.reverse_step)},
                                  {"dwell_mean", set(c.picker_motion.dwell_mean)},
                                  {"leg_radius", set(c.picker_motion.leg_radius)},
                                  {"leg_spread", set(c.picker_motion.leg_spread)},

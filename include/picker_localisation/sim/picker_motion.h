@@ -9,10 +9,14 @@
 //    enters a new lane (pickers keep a pace inside a lane, change it between lanes).
 //  - Optional dwell (picking): on arriving at a lane node the picker stops for Exp(mean dwell_mean) s
 //    (dwell_mean = 0 disables it; the default).
-//  - Reversal ("at any step, p_change chance of changing direction for t_reverse seconds"): a step is one
-//    arrival at a tour node. At each arrival while walking forward, with probability p_reverse the picker
-//    turns round and walks the tour backwards for t_reverse seconds (it keeps following the graph, through
-//    the headland if it gets there), then turns forward again. No reversal can start while one is running.
+//  - Reversal ("at any step, p_change chance of changing direction for t_reverse seconds"): a "step" is a
+//    reversal decision taken every `reverse_step` seconds of forward walking (default 60 s = t_reverse). At
+//    each decision the picker turns round with probability p_reverse, walks its tour backwards for t_reverse
+//    seconds (it keeps following the graph, through the headland if it gets there), then turns forward again;
+//    no decision is taken while a reversal runs. reverse_step = 0 takes the decision at every node arrival
+//    instead. Why not every node arrival by default: with 3 m edges at 0.5 m/s a decision per arrival gives a
+//    reversal every ~60 s of walking, each undoing ~30 m, i.e. no net progress along the lanes at all; one
+//    decision per t_reverse keeps the pickers reversed ~9 % of the time and moving through the lanes.
 #pragma once
 
 #include "picker_localisation/sim/sim_types.h"
@@ -30,7 +34,8 @@ struct PickerMotionParams {
   double speed_std = 0.1;        // m/s
   double speed_min = 0.2;        // m/s, truncation of the speed distribution
   double speed_max = 1.0;        // m/s
-  double p_reverse = 0.1;        // probability of turning round at each node arrival (Table I p_reverse)
+  double p_reverse = 0.1;        // probability of turning round at each reversal decision (Table I p_reverse)
+  double reverse_step = 60.0;    // s of forward walking between reversal decisions (0: at every node arrival)
   double t_reverse = 60.0;       // s walked backwards after turning round (Table I t_reverse)
   double dwell_mean = 0.0;       // s, mean of the exponential stop at each lane node (0: no stops)
   double leg_radius = 0.06;      // m, leg circle radius (for the laser ray cast)
@@ -69,13 +74,15 @@ class SimulatedPicker {
   std::array<Eigen::Vector2d, 2> legCentres() const;
   double legRadius() const { return params_.leg_radius; }
   const std::vector<topology::NodeIndex>& tour() const { return tour_; }
-  // Counters for tests: node arrivals while walking forward, and reversals started.
+  // Counters for tests: node arrivals while walking forward, reversal decisions taken, reversals started.
   std::size_t forwardArrivals() const { return forward_arrivals_; }
+  std::size_t reversalDecisions() const { return reversal_decisions_; }
   std::size_t reversalsStarted() const { return reversals_started_; }
   std::size_t lanesEntered() const { return lanes_entered_; }
 
  private:
   void arrive();
+  void decideReversal();
   void updatePose();
   double drawSpeed();
 
@@ -89,7 +96,8 @@ class SimulatedPicker {
   double dwell_until_ = 0.0;
   double lane_speed_ = 0.5;
   PickerState state_;
-  std::size_t forward_arrivals_ = 0, reversals_started_ = 0, lanes_entered_ = 0;
+  double next_decision_ = 0.0;  // s, time of the next reversal decision (reverse_step > 0)
+  std::size_t forward_arrivals_ = 0, reversal_decisions_ = 0, reversals_started_ = 0, lanes_entered_ = 0;
 };
 
 }  // namespace sim
