@@ -10,9 +10,11 @@
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/WhatIf.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <atomic>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -72,6 +74,14 @@ void goalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
   g_goals[msg->robot_id] = *msg;
 }
 
+std::map<std::string, diagnostic_msgs::DiagnosticStatus> g_diagnostics;  // by hardware id
+
+void diagnosticsCallback(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(g_mutex);
+  for (const auto& s : msg->status)
+    if (s.name.find("nbs_planner") != std::string::npos) g_diagnostics[s.hardware_id] = s;
+}
+
 void markerCallback(const visualization_msgs::MarkerArray::ConstPtr& m) {
   std::lock_guard<std::mutex> lock(g_mutex);
   for (const auto& mk : m->markers)
@@ -93,6 +103,8 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   ros::NodeHandle nh;
   const std::vector<std::string> robots{"robot_1", "robot_2", "robot_3"};
   std::vector<ros::Subscriber> subs;
+  subs.push_back(nh.subscribe("/diagnostics", 20, diagnosticsCallback));
+  subs.push_back(nh.subscribe("/robot_4/goal", 5, goalCallback));
   for (const std::string& r : robots) subs.push_back(nh.subscribe("/" + r + "/goal", 5, goalCallback));
   subs.push_back(nh.subscribe("/robot_1/nbs_candidates", 1, markerCallback));
 
@@ -150,6 +162,35 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   srv.request.max_candidates = 5;
   ASSERT_TRUE(client.call(srv));
   EXPECT_EQ(srv.response.nodes.size(), 5u);
+
+  // Bad input: a belief of a map we do not have (unknown node names) for picker_3 is rejected, planning goes on.
+  ros::Publisher b3 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_3/belief", 1, true);
+  picker_localisation::PickerBelief bad;
+  bad.picker_id = "picker_3";
+  bad.nodes = {"NoSuchNode", "NotThisOneEither"};
+  bad.masses = {0.5, std::nan("")};
+  b3.publish(bad);
+  ASSERT_TRUE(waitFor([] {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    auto it = g_diagnostics.find("robot_1");
+    if (it == g_diagnostics.end()) return false;
+    for (const auto& kv : it->second.values)
+      if (kv.key == "beliefs rejected picker_3" && kv.value != "0") return true;
+    return false;
+  }, 15.0)) << "robot_1 diagnostics never counted the bad belief";
+  const ros::Time before = ros::Time::now();
+  ASSERT_TRUE(waitFor([&] {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    return g_goals.at("robot_1").header.stamp > before;
+  }, 10.0)) << "robot_1 stopped planning after a bad belief";
+
+  // Missing tf: robot_4 publishes no goal and reports the missing pose.
+  std::lock_guard<std::mutex> lock(g_mutex);
+  EXPECT_EQ(g_goals.count("robot_4"), 0u);
+  ASSERT_EQ(g_diagnostics.count("robot_4"), 1u);
+  EXPECT_EQ(g_diagnostics.at("robot_4").level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_NE(g_diagnostics.at("robot_4").message.find("no robot pose"), std::string::npos)
+      << g_diagnostics.at("robot_4").message;
 }
 
 // The planner may only read beliefs, goals, the battery, tf and the clock: never a ground-truth topic.
@@ -177,7 +218,7 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }
   }
-  EXPECT_EQ(planners, 3u);
+  EXPECT_EQ(planners, 4u);
 }
 
 int main(int argc, char** argv) {
