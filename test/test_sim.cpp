@@ -185,8 +185,7 @@ TEST(PickerMotion, StaysOnTheGraphAndInLanes) {
   EXPECT_GT(in_lane, steps * 0.7);
 }
 
-// Runs pickers for `seconds` each and returns (decisions, reversals, reversed time share, reversal
-// durations).
+// Runs five pickers for `seconds` each: decisions, reversals, reversed time share, reversal durations.
 struct ReversalStats {
   std::size_t decisions = 0, reversals = 0, arrivals = 0;
   double reversed_share = 0.0;
@@ -673,8 +672,7 @@ TEST(CameraModel, BoxesOnlyInsideTheFieldOfView) {
     EXPECT_LE(b.x_offset + b.width, p.image_width);
     EXPECT_GE(b.y_offset, 0);
     EXPECT_LE(b.y_offset + b.height, p.image_height);
-    // Bearing of the noisy box centre: within a few pixels' worth of the truth (unless clipped at the
-    // border).
+    // Bearing of the noisy box centre: a few pixels' worth from the truth (unless clipped at the border).
     if (std::abs(b.true_bearing) < p.hfov / 2 - 0.1 && b.true_distance > 2.0)
       EXPECT_NEAR(b.bearing, b.true_bearing, 0.02);
   }

@@ -4,9 +4,9 @@
 //
 // Determinism: one seed. Every random process owns a std::mt19937_64 seeded from (seed, stream) through
 // SplitMix64, where the stream names the process (picker i motion, picker i GNSS, robot r patrol, robot r
-// laser,
-// ...). The same seed gives the same numbers, and switching a sensor off or changing the robots' goals does
-// not change the pickers' walks or their GNSS errors (so methods compared on one seed see the same pickers).
+// laser, ...). The same seed gives the same numbers, and switching a sensor off or changing the robots' goals
+// does not change the pickers' walks or their GNSS errors (so methods compared on one seed see the same
+// pickers).
 //
 // Time: the simulator integrates with a fixed internal step `time_step`; step(dt) / advanceTo(t) run as many
 // internal steps as needed (the last one shortened to land exactly on t). Sensors fire on their own grids:

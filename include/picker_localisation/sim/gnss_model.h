@@ -10,11 +10,10 @@
 //    N(0, drift_std^2), drift_std = 2.5 m (Table I gps_drift), correlation time drift_tau (default 300 s),
 //    started from its stationary distribution. Exact discretisation over dt:
 //      d <- a d + sqrt(1 - a^2) drift_std n,  a = exp(-dt / drift_tau),  n ~ N(0, 1).
-//  - blackouts (Table I gps_off): onsets form a Poisson process of rate 1 / blackout_mean_interval (default
-//  one
-//    per 600 s of non-blackout time); each lasts U(blackout_min, blackout_max) = U(30, 60) s. During a
-//    blackout the fix has status NO_FIX and NaN lat/lon/alt (or no fix at all, `blackout_emits_no_fix`
-//    false). The drift keeps evolving through a blackout.
+//  - blackouts (Table I gps_off): onsets form a Poisson process of rate 1 / blackout_mean_interval
+//    (default one per 600 s of non-blackout time); each lasts U(blackout_min, blackout_max) = U(30, 60) s.
+//    During a blackout the fix has status NO_FIX and NaN lat/lon/alt (or no fix at all,
+//    `blackout_emits_no_fix` false). The drift keeps evolving through a blackout.
 // The reported covariance is diagonal with reported_std^2 on east/north and (2 reported_std)^2 on up.
 #pragma once
 

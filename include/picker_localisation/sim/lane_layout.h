@@ -3,22 +3,19 @@
 // tours and the robots' patrol are built from it. ROS-free.
 //
 // The rule (works on any map with lanes; a map without lanes yields an empty layout):
-//  1. Order inside a lane: take the subgraph induced by the lane's nodes (undirected motion graph). If it is
-//  a
-//     simple chain (every node degree <= 2, exactly two degree-1 ends, connected), the chain order is the
-//     lane order. Otherwise (branches, gaps) the nodes are sorted by their projection on the lane's principal
-//     axis (largest-eigenvalue eigenvector of the covariance of the node positions); a single-node lane is
-//     its own both ends. The lane's two ends are the first and last node of that order.
-//  2. Farm axis: the principal axes of all lanes with >= 2 nodes, sign-aligned to the first one and weighted
-//  by
-//     lane length, are averaged into one unit "along" direction a; the "across" direction is a rotated by
-//     +90 deg. Lanes are oriented so that their first node has the smaller projection on a: the first node is
-//     the lane's entry end (the paper's "left side"), the last node its far end.
+//  1. Order inside a lane: take the subgraph induced by the lane's nodes (undirected motion graph). If it
+//     is a simple chain (every node degree <= 2, exactly two degree-1 ends, connected), the chain order is
+//     the lane order. Otherwise (branches, gaps) the nodes are sorted by their projection on the lane's
+//     principal axis (largest-eigenvalue eigenvector of the covariance of the node positions); a single-node
+//     lane is its own both ends. The lane's two ends are the first and last node of that order.
+//  2. Farm axis: the principal axes of all lanes with >= 2 nodes, sign-aligned to the first one and
+//     weighted by lane length, are averaged into one unit "along" direction a; the "across" direction is a
+//     rotated by +90 deg. Lanes are oriented so that their first node has the smaller projection on a: the
+//     first node is the lane's entry end (the paper's "left side"), the last node its far end.
 //  3. Adjacent lanes: lanes are sorted by the projection of their centroid on the across direction (ties
-//  broken
-//     by the projection on a, then by lane index). The lane adjacent to lane k in the walking order is the
-//     next one in that sorted list; the last lane's successor is the first (pickers start again from the far
-//     side).
+//     broken by the projection on a, then by lane index). The lane adjacent to lane k in the walking order is
+//     the next one in that sorted list; the last lane's successor is the first (pickers start again from the
+//     far side).
 #pragma once
 
 #include "picker_localisation/topology/topological_map.h"
@@ -64,11 +61,11 @@ class LaneLayout {
 // A closed walking tour over the map as a node sequence where consecutive nodes are adjacent in the motion
 // graph (the tour returns from its last node to its first through the graph as well).
 //  - Map with lanes: the serpentine of the paper (Sec. VI). Starting with lanes()[start], the picker walks
-//  each
-//    lane end to end, alternating direction: lanes at even positions (counted from lane 0 of the order) are
-//    walked entry end -> far end, odd positions far end -> entry end, so every lane is always walked in the
-//    same direction. Consecutive lanes are joined by the shortest path between the end just reached and the
-//    next lane's starting end (through the headland). After the last lane the tour continues with lane 0.
+//    each lane end to end, alternating direction: lanes at even positions (counted from lane 0 of the order)
+//    are walked entry end -> far end, odd positions far end -> entry end, so every lane is always walked in
+//    the same direction. Consecutive lanes are joined by the shortest path between the end just reached and
+//    the next lane's starting end (through the headland). After the last lane the tour continues with lane 0.
+//    A lane reachable through one end only (a dead end) is entered and left through that end.
 //  - Map without lanes: the shortest paths through `fallback_waypoints` (e.g. random nodes of the component).
 // Unreachable transitions are skipped (the next reachable lane is used); throws std::invalid_argument when
 // the tour would have fewer than two nodes.

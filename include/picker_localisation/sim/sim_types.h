@@ -45,8 +45,8 @@ struct GnssFix {
   bool in_blackout = false;
 };
 
-// sensor_msgs/LaserScan (no intensities). Ranges are +inf where a beam hits nothing within range_max (REP
-// 117).
+// sensor_msgs/LaserScan (no intensities). Ranges are +inf where a beam hits nothing within range_max
+// (REP 117).
 struct LaserScan {
   double stamp = 0.0;
   std::string robot_id;
