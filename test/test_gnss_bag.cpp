@@ -13,6 +13,7 @@
 
 #include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "ranging_test_maps.h"
 
 using namespace picker_localisation;
 using namespace picker_localisation::sensors;
@@ -20,18 +21,6 @@ using namespace picker_localisation::sensors;
 namespace {
 const std::string kBag = std::string(PL_SHARED_DATA) + "/robot_localization/test/test1.bag";
 
-std::shared_ptr<const topology::TopologicalMap> lattice(double half, double spacing) {
-  std::vector<topology::Node> nodes;
-  const int n = static_cast<int>(std::lround(2.0 * half / spacing));
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      topology::Node node;
-      node.name = "n_" + std::to_string(i) + "_" + std::to_string(j);
-      node.position = Eigen::Vector3d(-half + i * spacing, -half + j * spacing, 0.0);
-      nodes.push_back(node);
-    }
-  return std::make_shared<const topology::TopologicalMap>(topology::TopologicalMap::build("lattice", nodes, {}));
-}
 }  // namespace
 
 TEST(GnssBag, RealFixesOfTest1Bag) {
@@ -55,7 +44,7 @@ TEST(GnssBag, RealFixesOfTest1Bag) {
   dc.latitude = fixes.front().latitude;
   dc.longitude = fixes.front().longitude;
   GeodeticDatum datum(dc);
-  auto map = lattice(160.0, 4.0);
+  auto map = ranging_test::latticeMap(160.0, 4.0);
   GnssIngest gnss("husky", map, datum);
 
   double min_x = 1e9, max_x = -1e9, min_y = 1e9, max_y = -1e9, speed_sum = 0.0;

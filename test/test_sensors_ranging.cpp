@@ -12,6 +12,7 @@
 #include "picker_localisation/sensors_ranging/range_histogram_filter.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
+#include "ranging_test_maps.h"
 
 using namespace picker_localisation;
 using namespace picker_localisation::sensors;
@@ -21,19 +22,7 @@ namespace {
 
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Nodes on a square lattice with `spacing` m over [-half, half]^2, named n_<i>_<j>; no edges needed here.
-std::shared_ptr<const topology::TopologicalMap> latticeMap(double half, double spacing) {
-  std::vector<topology::Node> nodes;
-  const int n = static_cast<int>(std::lround(2.0 * half / spacing));
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      topology::Node node;
-      node.name = "n_" + std::to_string(i) + "_" + std::to_string(j);
-      node.position = Eigen::Vector3d(-half + i * spacing, -half + j * spacing, 0.0);
-      nodes.push_back(node);
-    }
-  return std::make_shared<const topology::TopologicalMap>(topology::TopologicalMap::build("lattice", nodes, {}));
-}
+using ranging_test::latticeMap;
 
 double likelihoodAt(const core::Observation& obs, NodeIndex n) {
   auto it = std::find(obs.nodes.begin(), obs.nodes.end(), n);

@@ -9,15 +9,16 @@ namespace picker_localisation {
 namespace ros_adapter {
 
 GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string pickers_file, datum_file;
-  if (!pnh.getParam("pickers_file", pickers_file) || !pnh.getParam("datum_file", datum_file)) {
-    ROS_FATAL("gnss_ingest: parameters ~pickers_file (config/pickers.yaml) and ~datum_file (config/datum.yaml) are required");
+  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
+  if (!registry_opt) return;
+  const core::PickerRegistry& registry = *registry_opt;
+  std::string datum_file;
+  if (!pnh.getParam("datum_file", datum_file)) {
+    ROS_FATAL("gnss_ingest: parameter ~datum_file (config/datum.yaml) is required");
     return;
   }
-  core::PickerRegistry registry;
   std::unique_ptr<sensors::GeodeticDatum> datum;
   try {
-    registry = core::PickerRegistry::load(pickers_file);
     datum = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
   } catch (const std::exception& e) {
     ROS_FATAL("gnss_ingest: %s", e.what());
@@ -54,7 +55,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
         p.gnss_topic, 50, [this, i](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, i); }));
     ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
   }
-  if (ingest_.empty()) ROS_WARN("gnss_ingest: no picker in %s has a gnss_topic", pickers_file.c_str());
+  if (ingest_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
   updater_.setHardwareID("gnss_ingest");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });

@@ -46,6 +46,20 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
   }
 }
 
+std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node) {
+  std::string path;
+  if (!pnh.getParam("pickers_file", path)) {
+    ROS_FATAL("%s: parameter ~pickers_file (config/pickers.yaml) is required", node);
+    return std::nullopt;
+  }
+  try {
+    return core::PickerRegistry::load(path);
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", node, e.what());
+    return std::nullopt;
+  }
+}
+
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
   Eigen::Isometry2d p = Eigen::Isometry2d::Identity();
   p.translation() = t.translation().head<2>();

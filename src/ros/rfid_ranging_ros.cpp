@@ -8,18 +8,9 @@ namespace picker_localisation {
 namespace ros_adapter {
 
 RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string pickers_file;
-  if (!pnh.getParam("pickers_file", pickers_file)) {
-    ROS_FATAL("rfid_ranging: parameter ~pickers_file (config/pickers.yaml) is required");
-    return;
-  }
-  core::PickerRegistry registry;
-  try {
-    registry = core::PickerRegistry::load(pickers_file);
-  } catch (const std::exception& e) {
-    ROS_FATAL("rfid_ranging: %s", e.what());
-    return;
-  }
+  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "rfid_ranging");
+  if (!registry_opt) return;
+  const core::PickerRegistry& registry = *registry_opt;
   sensors::RfidModelOptions o;
   pnh.param("read_range", o.read_range, o.read_range);
   pnh.param("beam_half_angle", o.beam_half_angle, o.beam_half_angle);

@@ -9,18 +9,9 @@ namespace picker_localisation {
 namespace ros_adapter {
 
 UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string pickers_file;
-  if (!pnh.getParam("pickers_file", pickers_file)) {
-    ROS_FATAL("uwb_ranging: parameter ~pickers_file (config/pickers.yaml) is required");
-    return;
-  }
-  core::PickerRegistry registry;
-  try {
-    registry = core::PickerRegistry::load(pickers_file);
-  } catch (const std::exception& e) {
-    ROS_FATAL("uwb_ranging: %s", e.what());
-    return;
-  }
+  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "uwb_ranging");
+  if (!registry_opt) return;
+  const core::PickerRegistry& registry = *registry_opt;
   sensors::UwbRangingOptions o;
   sensors::RhfOptions& h = o.rhf;
   pnh.param("grid_size_x", h.size_x, h.size_x);

@@ -34,6 +34,8 @@ sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg);
 std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, const std::string& target,
                                                  const std::string& source, const ros::Time& stamp,
                                                  double timeout, std::string* error);
+// The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
+std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
 // Planar part of a 3D transform: x, y and the yaw of the x axis.
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 
