@@ -14,7 +14,9 @@ install(TARGETS picker_localisation_sim ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB
 
 # ROS adapter and the farm_sim node.
 add_library(picker_localisation_sim_ros src/ros/farm_sim_node.cpp)
-target_link_libraries(picker_localisation_sim_ros PUBLIC picker_localisation_ros picker_localisation_sim)
+# picker_localisation_robot (URDF mounts, cmake/robot.cmake) is defined later; the name resolves at generate time.
+target_link_libraries(picker_localisation_sim_ros PUBLIC picker_localisation_ros picker_localisation_sim
+  picker_localisation_robot)
 add_dependencies(picker_localisation_sim_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_sim_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <thread>
 
+#include "picker_localisation/robot/robot_description.h"
 #include "picker_localisation/ros/map_source.h"
 
 namespace picker_localisation {
@@ -54,16 +55,37 @@ void overrideParam(ros::NodeHandle& pnh, const std::string& name, T& value) {
 
 }  // namespace
 
+sim::RobotSensorLayout sensorLayoutFromUrdfTemplate(const std::string& path) {
+  const robot::RobotDescription d = robot::RobotDescription::fromTemplateFile(path, "");
+  auto mounts = [&](const std::string& stem) {
+    std::vector<sim::SensorMount2D> out;
+    for (const auto& m : d.mountsStartingWith(stem)) {
+      if (m.link.size() >= 8 && m.link.compare(m.link.size() - 8, 8, "_optical") == 0) continue;
+      out.push_back({m.link, {m.x(), m.y(), m.yaw()}, m.z()});
+    }
+    return out;
+  };
+  sim::RobotSensorLayout layout;
+  layout.lasers = mounts("laser_");
+  layout.rfid_antennas = mounts("rfid_");
+  layout.uwb_anchors = mounts("uwb_anchor_");
+  layout.cameras = mounts("camera_");
+  if (layout.lasers.empty()) throw std::runtime_error(path + ": no laser_* link in the robot description");
+  return layout;
+}
+
 FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh) {
   // Configuration: ~sim_config file (config/sim.yaml), then individual parameter overrides.
   sim::SimConfig config;
-  std::string sim_config, pickers_file, datum_file;
+  std::string sim_config, pickers_file, datum_file, urdf_template;
   pnh_.param<std::string>("sim_config", sim_config, "");
+  pnh_.param<std::string>("urdf_template", urdf_template, "");
   pnh_.param<std::string>("pickers_file", pickers_file, "");
   pnh_.param<std::string>("datum_file", datum_file, "");
   try {
     if (!sim_config.empty()) config = sim::loadSimConfig(sim_config);
     if (!datum_file.empty()) config.datum = sim::loadMapDatum(datum_file);
+    if (!urdf_template.empty()) config.sensor_layout = sensorLayoutFromUrdfTemplate(urdf_template);
     if (!pickers_file.empty()) {
       registry_ = core::PickerRegistry::load(pickers_file);
       config.pickers = sim::pickerSpecsFromRegistry(registry_);

@@ -20,6 +20,11 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+// The sensor mounts of a robot URDF template (config/robot/thorvald.urdf.in): links laser_*, rfid_*,
+// uwb_anchor_*, camera_* (not *_optical) in base_link, projected to the plane (x, y, yaw) + height z. Base
+// footprint size stays at the defaults. Throws std::runtime_error (one line) on a bad file or no lasers.
+sim::RobotSensorLayout sensorLayoutFromUrdfTemplate(const std::string& path);
+
 class FarmSimNode {
  public:
   FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
