@@ -34,7 +34,8 @@ std::shared_ptr<const topology::TopologicalMap> laneMap(std::size_t n = 5, doubl
 }
 
 std::shared_ptr<const topology::TopologicalMap> polytunnel() {
-  return std::make_shared<const topology::TopologicalMap>(topology::makePolytunnelMap(topology::PolytunnelSpec()));
+  return std::make_shared<const topology::TopologicalMap>(
+      topology::makePolytunnelMap(topology::PolytunnelSpec()));
 }
 
 core::Observation obsAt(double stamp, std::vector<NodeIndex> nodes, std::vector<double> l,
@@ -95,7 +96,8 @@ TEST(TpfEquations, Eq2Eq3ProjectionWeightsAndNoJumpAgainstVelocity) {
   EXPECT_NEAR(t[1], 0.5, 1e-12);
   EXPECT_NEAR(f.jumpProbability(mid, 0.5, 0.0, 3.0), 0.5, 1e-12);
   // Diagonal velocity (0.3, 0.4): only the x projection (0.3) counts on this lane; b = (0, 0.3).
-  EXPECT_NEAR(f.jumpProbability(mid, 0.3, 0.4, 2.0), 1.0 - std::exp(2.0 * std::log(0.5) * 0.3 / 3.0 * 2.0), 1e-12);
+  EXPECT_NEAR(f.jumpProbability(mid, 0.3, 0.4, 2.0), 1.0 - std::exp(2.0 * std::log(0.5) * 0.3 / 3.0 * 2.0),
+              1e-12);
   // Perpendicular or zero velocity: no positive projection, no jump.
   EXPECT_EQ(f.jumpProbability(mid, 0.0, 0.7, 50.0), 0.0);
   EXPECT_EQ(f.jumpProbability(mid, 0.0, 0.0, 50.0), 0.0);
@@ -109,8 +111,8 @@ TEST(TpfEquations, Eq2MixesSeveralEdgesByProjection) {
   nodes[1].position = Eigen::Vector3d(3, 0, 0);
   nodes[2].name = "b";
   nodes[2].position = Eigen::Vector3d(0, 4, 0);
-  auto map = std::make_shared<const topology::TopologicalMap>(topology::TopologicalMap::build(
-      "star", nodes, {{"ca", "c", "a", ""}, {"cb", "c", "b", ""}}));
+  auto map = std::make_shared<const topology::TopologicalMap>(
+      topology::TopologicalMap::build("star", nodes, {{"ca", "c", "a", ""}, {"cb", "c", "b", ""}}));
   TopologicalParticleFilter f(map, TpfParams(), 1);
   const double tau = 2.0;
   const double p1 = 1.0 - std::exp(2.0 * std::log(0.5) * 1.0 / 3.0 * tau);
@@ -229,8 +231,8 @@ TEST(TpfEquations, Eq8WeightPerSensor) {
 // --------------------------------------------------------------------------------- JSD and entropy ------
 TEST(TpfEquations, JensenShannonDistance) {
   using D = std::vector<std::pair<NodeIndex, double>>;
-  EXPECT_NEAR(TopologicalParticleFilter::jensenShannonDistance(D{{1, 0.3}, {4, 0.7}}, D{{4, 0.7}, {1, 0.3}}), 0.0,
-              1e-12);
+  EXPECT_NEAR(TopologicalParticleFilter::jensenShannonDistance(D{{1, 0.3}, {4, 0.7}}, D{{4, 0.7}, {1, 0.3}}),
+              0.0, 1e-12);
   EXPECT_NEAR(TopologicalParticleFilter::jensenShannonDistance(D{{1, 1.0}}, D{{2, 1.0}}), 1.0, 1e-12);
   // P = (1, 0), Q = (1/2, 1/2), M = (3/4, 1/4):
   // KL(P||M) = log2(4/3); KL(Q||M) = 1/2 log2(2/3) + 1/2 log2(2); JSD = sqrt((KL + KL) / 2).
@@ -257,7 +259,8 @@ TEST(TpfFilter, SparseJsdMatchesDefinition) {
   std::vector<std::pair<NodeIndex, double>> q;
   for (const auto& [n, v] : nodeFractions(f.particles())) q.push_back({n, v});
   auto o = obsAt(1.0, {11, 12, 13}, {1.0, 1.0, 2.0});
-  const double expected = TopologicalParticleFilter::jensenShannonDistance(q, {{11, 0.25}, {12, 0.25}, {13, 0.5}});
+  const double expected =
+      TopologicalParticleFilter::jensenShannonDistance(q, {{11, 0.25}, {12, 0.25}, {13, 0.5}});
   ASSERT_TRUE(f.update(o).ok());
   EXPECT_NEAR(f.belief().jsd, expected, 1e-12);
 }
@@ -574,7 +577,8 @@ TEST(TpfParamsTest, PresetsAndErrors) {
   EXPECT_TRUE(cs.accepted_sensors.empty());
   EXPECT_THROW(TpfParams::presetForMethod("nope"), std::invalid_argument);
   // YAML: the method preset wins over the file's mode switches; other values stay.
-  auto y = TpfParams::fromYaml(YAML::Load("{method: khan_connected, num_particles: 77, motion_model: velocity}"));
+  auto y =
+      TpfParams::fromYaml(YAML::Load("{method: khan_connected, num_particles: 77, motion_model: velocity}"));
   EXPECT_EQ(y.num_particles, 77u);
   EXPECT_EQ(y.motion_model, tpf::MotionModel::kFixedLambda);
   auto g = TpfParams::fromYaml(YAML::Load("{sensor_gammas: {sonar: {node: 0.5, velocity: 0.1}}}"));
@@ -755,8 +759,7 @@ TEST(TpfTracking, RiseholmeLaneWithExactGnssWithinOneHop) {
   // The longest lane, walked end to end, in the order of the lane's chain.
   topology::LaneIndex best = 0;
   for (std::size_t l = 0; l < map->numLanes(); ++l)
-    if (map->laneNodes(static_cast<topology::LaneIndex>(l)).size() >
-        map->laneNodes(best).size())
+    if (map->laneNodes(static_cast<topology::LaneIndex>(l)).size() > map->laneNodes(best).size())
       best = static_cast<topology::LaneIndex>(l);
   const auto& lane = map->laneNodes(best);
   // End node: a lane node with at most one lane neighbour; then the shortest path to the other end.

@@ -36,14 +36,18 @@ class TrackerTest : public ::testing::Test {
         topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
     pub_ = nh_.advertise<picker_localisation::Observation>("/observations", 50);
     for (const std::string id : {"picker_1", "picker_2", "picker_3"}) {
-      subs_.push_back(nh_.subscribe<PickerBelief>("/pickers/" + id + "/belief", 50,
-                                                  [this, id](const PickerBelief::ConstPtr& m) { topics_[id].beliefs.push_back(*m); }));
+      subs_.push_back(nh_.subscribe<PickerBelief>(
+          "/pickers/" + id + "/belief", 50,
+          [this, id](const PickerBelief::ConstPtr& m) { topics_[id].beliefs.push_back(*m); }));
       subs_.push_back(nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
           "/pickers/" + id + "/estimate", 50,
-          [this, id](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { topics_[id].estimates.push_back(*m); }));
+          [this, id](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) {
+            topics_[id].estimates.push_back(*m);
+          }));
       subs_.push_back(nh_.subscribe<visualization_msgs::MarkerArray>(
-          "/pickers/" + id + "/markers", 50,
-          [this, id](const visualization_msgs::MarkerArray::ConstPtr& m) { topics_[id].markers.push_back(*m); }));
+          "/pickers/" + id + "/markers", 50, [this, id](const visualization_msgs::MarkerArray::ConstPtr& m) {
+            topics_[id].markers.push_back(*m);
+          }));
       ASSERT_TRUE(ros::service::waitForService("/pickers/" + id + "/what_if", ros::Duration(60.0))) << id;
     }
     // Wait until every tracker is subscribed to /observations.
@@ -72,7 +76,8 @@ class TrackerTest : public ::testing::Test {
   }
 
   // An observation centred on a node (Gaussian likelihood, sigma 1 m).
-  core::Observation observationAt(const std::string& node, const std::string& sensor, const std::string& picker) {
+  core::Observation observationAt(const std::string& node, const std::string& sensor,
+                                  const std::string& picker) {
     core::Observation o;
     o.stamp = ros::Time::now().toSec();
     o.sensor = sensor;
@@ -82,7 +87,9 @@ class TrackerTest : public ::testing::Test {
     return o;
   }
   void send(const core::Observation& o) { pub_.publish(ros_adapter::toMsg(o, *map_)); }
-  int hops(const std::string& a, const std::string& b) { return map_->hopDistance(*map_->index(a), *map_->index(b)); }
+  int hops(const std::string& a, const std::string& b) {
+    return map_->hopDistance(*map_->index(a), *map_->index(b));
+  }
 
   ros::NodeHandle nh_;
   std::shared_ptr<topology::TopologicalMap> map_;
@@ -131,11 +138,14 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
   // 2. picker_2's identifying GNSS at node B never reaches picker_1.
   const std::size_t p1_count = topics_["picker_1"].beliefs.size();
   send(observationAt(node_b, "gnss", "picker_2"));
-  ASSERT_TRUE(waitFor([&] { return !topics_["picker_2"].beliefs.empty() && topics_["picker_2"].beliefs.back().observations == 1; }));
+  ASSERT_TRUE(waitFor([&] {
+    return !topics_["picker_2"].beliefs.empty() && topics_["picker_2"].beliefs.back().observations == 1;
+  }));
   EXPECT_LE(hops(topics_["picker_2"].beliefs.back().estimated_node, node_b), 1);
   spinFor(0.2);
   for (std::size_t k = p1_count; k < topics_["picker_1"].beliefs.size(); ++k)
-    EXPECT_EQ(topics_["picker_1"].beliefs[k].observations, b1.observations) << "picker_1 fused picker_2's fix";
+    EXPECT_EQ(topics_["picker_1"].beliefs[k].observations, b1.observations)
+        << "picker_1 fused picker_2's fix";
 
   // 3. A non-identifying LiDAR detection at A reaches every tracker (picker_3 initialises from it).
   send(observationAt(node_a, "lidar", ""));
@@ -146,7 +156,8 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
 
   // 4. Periodic prediction (picker_1 at 2 Hz) without observations: newer stamps, same observation count.
   const double last_stamp = topics_["picker_1"].beliefs.back().header.stamp.toSec();
-  ASSERT_TRUE(waitFor([&] { return topics_["picker_1"].beliefs.back().header.stamp.toSec() > last_stamp + 0.4; }, 5.0));
+  ASSERT_TRUE(waitFor(
+      [&] { return topics_["picker_1"].beliefs.back().header.stamp.toSec() > last_stamp + 0.4; }, 5.0));
   EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, b1.observations + 1);
 
   // 5. What-if: predict ahead, and posterior under a hypothetical observation at B; the live filter stays.
@@ -177,10 +188,12 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
   picker_localisation::Observation bad = ros_adapter::toMsg(observationAt(node_a, "gnss", "picker_1"), *map_);
   bad.likelihood[0] = std::nan("");
   pub_.publish(bad);
-  picker_localisation::Observation unknown = ros_adapter::toMsg(observationAt(node_a, "gnss", "picker_1"), *map_);
+  picker_localisation::Observation unknown =
+      ros_adapter::toMsg(observationAt(node_a, "gnss", "picker_1"), *map_);
   for (auto& n : unknown.nodes) n = "no_such_node_" + n;
   pub_.publish(unknown);
-  picker_localisation::Observation stale = ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
+  picker_localisation::Observation stale =
+      ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
   stale.header.stamp = ros::Time(1.0);
   pub_.publish(stale);
   spinFor(0.5);

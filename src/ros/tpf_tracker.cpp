@@ -16,10 +16,14 @@ namespace {
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
   XmlRpc::XmlRpcValue& x = const_cast<XmlRpc::XmlRpcValue&>(v);  // XmlRpcValue's accessors are not const
   switch (x.getType()) {
-    case XmlRpc::XmlRpcValue::TypeBoolean: return YAML::Node(static_cast<bool>(x));
-    case XmlRpc::XmlRpcValue::TypeInt: return YAML::Node(static_cast<int>(x));
-    case XmlRpc::XmlRpcValue::TypeDouble: return YAML::Node(static_cast<double>(x));
-    case XmlRpc::XmlRpcValue::TypeString: return YAML::Node(static_cast<std::string>(x));
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return YAML::Node(static_cast<bool>(x));
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return YAML::Node(static_cast<int>(x));
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return YAML::Node(static_cast<double>(x));
+    case XmlRpc::XmlRpcValue::TypeString:
+      return YAML::Node(static_cast<std::string>(x));
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node n(YAML::NodeType::Sequence);
       for (int i = 0; i < x.size(); ++i) n.push_back(toYaml(x[i]));
@@ -30,11 +34,14 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
       for (auto it = x.begin(); it != x.end(); ++it) n[it->first] = toYaml(it->second);
       return n;
     }
-    default: return YAML::Node();
+    default:
+      return YAML::Node();
   }
 }
 
-ros::Time rosTime(double stamp) { return ros::Time(std::max(0.0, std::isfinite(stamp) ? stamp : 0.0)); }
+ros::Time rosTime(double stamp) {
+  return ros::Time(std::max(0.0, std::isfinite(stamp) ? stamp : 0.0));
+}
 
 // Blue (low) -> red (high) for a mass relative to the largest.
 std_msgs::ColorRGBA massColour(double relative) {
@@ -105,7 +112,8 @@ picker_localisation::PickerBelief toBeliefMsg(const tpf::Belief& b, const topolo
   return m;
 }
 
-geometry_msgs::PoseWithCovarianceStamped toEstimateMsg(const tpf::Belief& b, const topology::TopologicalMap& map,
+geometry_msgs::PoseWithCovarianceStamped toEstimateMsg(const tpf::Belief& b,
+                                                       const topology::TopologicalMap& map,
                                                        const std::string& frame_id) {
   geometry_msgs::PoseWithCovarianceStamped m;
   m.header.stamp = rosTime(b.stamp);
@@ -223,7 +231,8 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_
   }
   diagnostics_.setHardwareID(picker_id_);
   diagnostics_.add("tpf_tracker " + picker_id_, this, &TpfTracker::diagnose);
-  diagnostics_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_timer_ =
+      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
   ROS_INFO("tpf_tracker %s: %zu particles, method %s motion, map '%s' (%zu nodes), prediction every %.1f s",
            picker_id_.c_str(), params.num_particles, tpf::toString(params.motion_model), map_->name().c_str(),
            map_->numNodes(), prediction_period_);
@@ -239,7 +248,8 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
   const core::Observation obs = fromMsg(*msg, *map_, &unknown);
   if (unknown > 0) {
     unknown_nodes_ += unknown;
-    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %zu node name(s) of a %s observation are not in the map (skipped)",
+    ROS_WARN_THROTTLE(5.0,
+                      "tpf_tracker %s: %zu node name(s) of a %s observation are not in the map (skipped)",
                       picker_id_.c_str(), unknown, msg->sensor.c_str());
   }
   const tpf::UpdateResult r = filter_->update(obs);
@@ -252,7 +262,8 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
     return;
   }
   if (r.reinitialised)
-    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", picker_id_.c_str(), filter_->belief().jsd);
+    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", picker_id_.c_str(),
+                      filter_->belief().jsd);
   publish();
 }
 
@@ -263,7 +274,8 @@ void TpfTracker::timerCallback(const ros::TimerEvent&) {
   if (filter_->predictTo(now)) publish();
 }
 
-bool TpfTracker::reset(picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res) {
+bool TpfTracker::reset(picker_localisation::ResetBelief::Request&,
+                       picker_localisation::ResetBelief::Response& res) {
   filter_->reset();
   ++resets_;
   res.success = true;
@@ -272,7 +284,8 @@ bool TpfTracker::reset(picker_localisation::ResetBelief::Request&, picker_locali
   return true;
 }
 
-bool TpfTracker::whatIf(picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
+bool TpfTracker::whatIf(picker_localisation::WhatIf::Request& req,
+                        picker_localisation::WhatIf::Response& res) {
   ++what_if_calls_;
   if (!std::isfinite(req.horizon) || req.horizon < 0.0) {
     res.success = false;

@@ -46,7 +46,8 @@ std::vector<core::Observation> walkObservations(const topology::TopologicalMap& 
   return out;
 }
 
-void runUpdates(benchmark::State& state, std::size_t map_nodes, std::size_t particles, const std::string& method) {
+void runUpdates(benchmark::State& state, std::size_t map_nodes, std::size_t particles,
+                const std::string& method) {
   auto map = std::make_shared<const topology::TopologicalMap>(
       topology::makePolytunnelMap(topology::polytunnelSpecWithNodes(map_nodes)));
   tpf::TpfParams params = tpf::TpfParams::presetForMethod(method);
@@ -71,17 +72,22 @@ void runUpdates(benchmark::State& state, std::size_t map_nodes, std::size_t part
     ns += threadCpuNs() - t0;
     ++updates;
   }
-  state.counters["ns_per_particle_update"] = ns / (static_cast<double>(updates) * static_cast<double>(particles));
+  state.counters["ns_per_particle_update"] =
+      ns / (static_cast<double>(updates) * static_cast<double>(particles));
   state.counters["particles"] = static_cast<double>(particles);
   state.counters["map_nodes"] = static_cast<double>(map->numNodes());
   state.counters["support"] = static_cast<double>(filter.belief().nodes.size());
 }
 
-void BM_TpfParticles(benchmark::State& s) { runUpdates(s, 138, static_cast<std::size_t>(s.range(0)), "tpf"); }
+void BM_TpfParticles(benchmark::State& s) {
+  runUpdates(s, 138, static_cast<std::size_t>(s.range(0)), "tpf");
+}
 void BM_KhanParticles(benchmark::State& s) {
   runUpdates(s, 138, static_cast<std::size_t>(s.range(0)), "khan_unconnected");
 }
-void BM_TpfMapSize(benchmark::State& s) { runUpdates(s, static_cast<std::size_t>(s.range(0)), 10000, "tpf"); }
+void BM_TpfMapSize(benchmark::State& s) {
+  runUpdates(s, static_cast<std::size_t>(s.range(0)), 10000, "tpf");
+}
 void BM_KhanMapSize(benchmark::State& s) {
   runUpdates(s, static_cast<std::size_t>(s.range(0)), 10000, "khan_unconnected");
 }

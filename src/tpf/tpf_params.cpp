@@ -42,7 +42,8 @@ std::string TpfParams::validate() const {
   if (!finite_nonneg(fixed_lambda)) return "fixed_lambda must be >= 0";
   if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window)) return "velocity_window must be >= 1";
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell)) return "min_jump_dwell must be > 0";
-  if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma)) return "min_velocity_sigma must be > 0";
+  if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma))
+    return "min_velocity_sigma must be > 0";
   for (const auto& [name, g] : sensor_gammas)
     if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity) || (gamma_as_confidence && g.node > 1.0))
       return "sensor_gammas." + name + " must be finite and >= 0 (node <= 1 with gamma_as_confidence)";
@@ -71,9 +72,29 @@ void read(const YAML::Node& node, const char* key, T& value) {
   }
 }
 
+// A string key naming one of `choices`.
+template <typename E>
+void readChoice(const YAML::Node& node, const char* key,
+                const std::vector<std::pair<std::string, E>>& choices, E& value) {
+  std::string name;
+  read(node, key, name);
+  if (name.empty()) return;
+  std::string known;
+  for (const auto& [n, v] : choices) {
+    if (n == name) {
+      value = v;
+      return;
+    }
+    known += (known.empty() ? "" : " | ") + n;
+  }
+  throw std::runtime_error(std::string("tpf params: '") + key + "' must be " + known + ", got '" + name +
+                           "'");
+}
+
 SensorGamma readGamma(const YAML::Node& node, const std::string& key) {
   SensorGamma g;
-  if (!node.IsMap()) throw std::runtime_error("tpf params: '" + key + "' must be a map {node: .., velocity: ..}");
+  if (!node.IsMap())
+    throw std::runtime_error("tpf params: '" + key + "' must be a map {node: .., velocity: ..}");
   read(node, "node", g.node);
   read(node, "velocity", g.velocity);
   return g;
@@ -89,12 +110,10 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   std::size_t particles = p.num_particles;
   read(node, "num_particles", particles);
   p.num_particles = particles;
-  if (node["resampling"]) {
-    const std::string r = node["resampling"].as<std::string>();
-    if (r == "low_variance") p.resampling = ResamplingScheme::kLowVariance;
-    else if (r == "multinomial") p.resampling = ResamplingScheme::kMultinomial;
-    else throw std::runtime_error("tpf params: resampling must be low_variance or multinomial, got '" + r + "'");
-  }
+  readChoice(
+      node, "resampling",
+      {{"low_variance", ResamplingScheme::kLowVariance}, {"multinomial", ResamplingScheme::kMultinomial}},
+      p.resampling);
   read(node, "velocity_init_mean", p.velocity_init_mean);
   read(node, "velocity_init_variance", p.velocity_init_variance);
   read(node, "dwell_init_min", p.dwell_init_min);
@@ -103,12 +122,9 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "velocity_noise_variance", p.velocity_noise_variance);
   read(node, "dwell_noise_min", p.dwell_noise_min);
   read(node, "dwell_noise_max", p.dwell_noise_max);
-  if (node["motion_model"]) {
-    const std::string m = node["motion_model"].as<std::string>();
-    if (m == "velocity") p.motion_model = MotionModel::kVelocity;
-    else if (m == "fixed_lambda") p.motion_model = MotionModel::kFixedLambda;
-    else throw std::runtime_error("tpf params: motion_model must be velocity or fixed_lambda, got '" + m + "'");
-  }
+  readChoice(node, "motion_model",
+             {{"velocity", MotionModel::kVelocity}, {"fixed_lambda", MotionModel::kFixedLambda}},
+             p.motion_model);
   read(node, "fixed_lambda", p.fixed_lambda);
   read(node, "velocity_window", p.velocity_window);
   read(node, "min_jump_dwell", p.min_jump_dwell);
@@ -173,8 +189,10 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.accepted_sensors = {"gnss"};
     p.jsd_monitor = false;
     p.entropy_gate = false;
-    if (method == "khan_connected") p.unconnected_jump_probability = 0.0;
-    else if (p.unconnected_jump_probability <= 0.0) p.unconnected_jump_probability = 1e-3;
+    if (method == "khan_connected")
+      p.unconnected_jump_probability = 0.0;
+    else if (p.unconnected_jump_probability <= 0.0)
+      p.unconnected_jump_probability = 1e-3;
     return p;
   }
   if (method == "no_monitor") {
@@ -196,7 +214,9 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
   throw std::invalid_argument("unknown TPF method '" + method + "' (known:" + names.str() + ")");
 }
 
-const char* toString(MotionModel m) { return m == MotionModel::kVelocity ? "velocity" : "fixed_lambda"; }
+const char* toString(MotionModel m) {
+  return m == MotionModel::kVelocity ? "velocity" : "fixed_lambda";
+}
 const char* toString(ResamplingScheme r) {
   return r == ResamplingScheme::kLowVariance ? "low_variance" : "multinomial";
 }

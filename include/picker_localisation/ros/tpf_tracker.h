@@ -2,13 +2,13 @@
 //
 // Subscribes ~observations_topic (default /observations, picker_localisation/Observation): identifying
 // observations only when their picker_id is this tracker's ~picker_id, non-identifying ones always.
-// Publishes <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate (geometry_msgs/PoseWithCovarianceStamped,
-// the MAP node's pose; covariance = mass-weighted spread of the belief's nodes), <prefix>/<id>/markers
-// (MarkerArray: belief support coloured by mass, MAP node highlighted); prefix ~topic_prefix = /pickers.
-// Services <prefix>/<id>/reset (ResetBelief) and <prefix>/<id>/what_if (WhatIf, on a copy of the filter).
-// Periodic prediction at prediction_rate Hz of ROS time (ros::Timer: sim time and bags work) when no
-// observation arrived for a period. Diagnostics: counts of accepted / reordered / dropped / rejected /
-// other-picker observations, re-initialisations, health.
+// Publishes <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
+// (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
+// belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node
+// highlighted); prefix ~topic_prefix = /pickers. Services <prefix>/<id>/reset (ResetBelief) and
+// <prefix>/<id>/what_if (WhatIf, on a copy of the filter). Periodic prediction at prediction_rate Hz of ROS
+// time (ros::Timer: sim time and bags work) when no observation arrived for a period. Diagnostics: counts of
+// accepted / reordered / dropped / rejected / other-picker observations, re-initialisations, health.
 // Parameters (private): picker_id (required), map_file (else the latched topological_map topic),
 // tpf_params_file (YAML like config/tpf.yaml) overridden key by key by private parameters with the same
 // names (e.g. ~num_particles, ~method), seed (0: derived from picker_id), frame_id (map).
@@ -17,11 +17,11 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/ResetBelief.h>
 #include <picker_localisation/WhatIf.h>
-#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <memory>

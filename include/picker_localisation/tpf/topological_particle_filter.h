@@ -14,10 +14,11 @@
 // and only touched at the nodes that hold particles or likelihood.
 //
 // Interpretation choices where the paper is vague (details at the code):
-//  * Eqs. 2/3: Eq. 3 read literally (softmax of exp(lambda*tau)) gives the LARGEST probability to nodes against
+//  * Eqs. 2/3: Eq. 3 read literally (softmax of exp(lambda*tau)) gives the LARGEST probability to nodes
+//  against
 //    the velocity (lambda = 0), contradicting the text ("null probability to those in the opposite
-//    direction"). We use the decomposition of Eq. 2 itself: P(jump to k) = b_k (1 - exp(lambda_k tau)) / sum b,
-//    so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen. Without any
+//    direction"). We use the decomposition of Eq. 2 itself: P(jump to k) = b_k (1 - exp(lambda_k tau)) / sum
+//    b, so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen. Without any
 //    positive projection (sum b = 0) a particle stays.
 //  * tau in Eq. 2 is the dwell time at the prediction instant (tau_t + dt); at most one jump per prediction.
 //    With step_consistent_jumps (default) Eq. 2 is read as the probability of having left the node after
@@ -25,10 +26,11 @@
 //    sum_k b_k (exp(l_k tau_t) - exp(l_k (tau_t + dt))) / sum_k b_k exp(l_k tau_t): one 3 s step and thirty
 //    0.1 s steps move the particles alike (the literal reading applies Eq. 2 afresh at every observation, so
 //    particles would run faster the more sensors report). A step with dt = 0 never jumps.
-//  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector along
-//    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the Eq. 2-3 probability of the transition taken
-//    at the dwell reached (transitionProbabilities(), independent of the step length); a
-//    particle that stays keeps its velocity (the literal d = 0 case would decay it towards 0 while waiting).
+//  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector
+//  along
+//    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the Eq. 2-3 probability of the transition
+//    taken at the dwell reached (transitionProbabilities(), independent of the step length); a particle that
+//    stays keeps its velocity (the literal d = 0 case would decay it towards 0 while waiting).
 //  * Eq. 8: L enters normalised to its maximum (likelihood scale is arbitrary, see core::Observation), the
 //    Gaussian g is unnormalised (peak 1) with sigma = max(|v^s|/2, min_velocity_sigma); w_v = 0 when the
 //    observation carries no velocity.
@@ -88,16 +90,16 @@ struct FilterCounters {
 // The belief after the last update or prediction.
 struct Belief {
   bool initialised = false;
-  double stamp = 0.0;                       // s, stamp of the last update / prediction
-  std::vector<topology::NodeIndex> nodes;   // support (nodes holding particles), ascending index
-  std::vector<double> masses;               // normalised topological mass per node (Eq. 9), sums to 1
+  double stamp = 0.0;                      // s, stamp of the last update / prediction
+  std::vector<topology::NodeIndex> nodes;  // support (nodes holding particles), ascending index
+  std::vector<double> masses;              // normalised topological mass per node (Eq. 9), sums to 1
   topology::NodeIndex map_node = topology::kInvalidNode;  // n* (Eq. 10); ties -> lowest index
-  double entropy = 0.0;                     // H of the particles' node distribution, nats (Alg. 1 l. 12)
-  double jsd = 0.0;                         // JSD of the last observation vs the predicted particles, [0, 1]
-  bool reinitialised = false;               // the last update re-initialised the particles
+  double entropy = 0.0;        // H of the particles' node distribution, nats (Alg. 1 l. 12)
+  double jsd = 0.0;            // JSD of the last observation vs the predicted particles, [0, 1]
+  bool reinitialised = false;  // the last update re-initialised the particles
   double unconnected_jump_probability = 0.0;  // current p_rj
   std::size_t particle_count = 0;
-  std::uint64_t observations = 0;           // observations fused since construction / reset
+  std::uint64_t observations = 0;              // observations fused since construction / reset
   double massOf(topology::NodeIndex n) const;  // 0 outside the support
 };
 
@@ -179,7 +181,7 @@ class TopologicalParticleFilter {
   // |N|-sized scratch, all zero between calls (touched entries are cleared after use).
   std::vector<double> node_scratch_a_, node_scratch_b_;
   std::vector<topology::NodeIndex> touched_;
-  std::vector<double> edge_scratch_;  // per-edge jump contributions of one particle (max degree)
+  std::vector<double> edge_scratch_;       // per-edge jump contributions of one particle (max degree)
   std::vector<std::uint32_t> spare_bits_;  // per particle: random bits of the prediction draw used by Eq. 12
 
   double unconnected_p_ = 0.0;  // p_rj

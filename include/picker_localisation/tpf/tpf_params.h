@@ -24,8 +24,9 @@ struct SensorGamma {
 enum class MotionModel {
   kVelocity,     // Eqs. 2-7: lambda from the particle velocity projected on each edge (Eq. 6), velocity state
                  // updated over the window V (Eq. 7); the full TPF.
-  kFixedLambda,  // Khan et al. [1] Eq. 2 / ConstantSpeed ablation: jump probability 1 - exp(-fixed_lambda * tau)
-                 // to a uniformly chosen neighbour; particle velocity neither used nor estimated, w_v = 0.
+  kFixedLambda,  // Khan et al. [1] Eq. 2 / ConstantSpeed ablation: jump probability 1 - exp(-fixed_lambda *
+                 // tau) to a uniformly chosen neighbour; particle velocity neither used nor estimated, w_v =
+                 // 0.
 };
 
 enum class ResamplingScheme {
@@ -52,10 +53,10 @@ struct TpfParams {
 
   // --- Eqs. 2-7, prediction --------------------------------------------------------------------------------
   MotionModel motion_model = MotionModel::kVelocity;
-  double fixed_lambda = 0.1;       // 1/s, Khan et al.'s constant rate (kFixedLambda only)
-  double velocity_window = 10.0;   // V of Eq. 7 (dimensionless number of steps; not in Table I)
-  double min_jump_dwell = 0.1;     // s, floor on the dwell time used for the observed speed of Eq. 7
-  bool directed_motion = false;    // true: particles follow file edge direction; false: undirected graph
+  double fixed_lambda = 0.1;      // 1/s, Khan et al.'s constant rate (kFixedLambda only)
+  double velocity_window = 10.0;  // V of Eq. 7 (dimensionless number of steps; not in Table I)
+  double min_jump_dwell = 0.1;    // s, floor on the dwell time used for the observed speed of Eq. 7
+  bool directed_motion = false;   // true: particles follow file edge direction; false: undirected graph
   // true: Eq. 2 is the probability of having left the node after dwelling tau, so a prediction step of dt
   // jumps with the conditional probability 1 - S(tau + dt) / S(tau), S = 1 - Eq. 2 (the motion no longer
   // depends on how often observations arrive). false: Eq. 2 at tau is applied at every prediction (paper
@@ -74,11 +75,12 @@ struct TpfParams {
   // Sensors this filter fuses; empty = all. Observations of other sensors are ignored (counted).
   std::vector<std::string> accepted_sensors;
 
-  // --- Algorithm 1, monitors ---------------------------------------------------------------------------------
-  bool jsd_monitor = true;          // re-initialise when JSD > jsd_threshold on an identifying observation
-  double jsd_threshold = 0.975;     // epsilon_JSD, [0, 1]
-  bool entropy_gate = true;         // set p_rj to 0 once the entropy drops below entropy_threshold
-  double entropy_threshold = 0.6;   // epsilon_H, nats
+  // --- Algorithm 1, monitors
+  // ---------------------------------------------------------------------------------
+  bool jsd_monitor = true;         // re-initialise when JSD > jsd_threshold on an identifying observation
+  double jsd_threshold = 0.975;    // epsilon_JSD, [0, 1]
+  bool entropy_gate = true;        // set p_rj to 0 once the entropy drops below entropy_threshold
+  double entropy_threshold = 0.6;  // epsilon_H, nats
   double unconnected_jump_probability = 1e-3;  // p_rj at start and after each re-initialisation (Alg. 1 l. 8)
 
   // --- time ------------------------------------------------------------------------------------------------
