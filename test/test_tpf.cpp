@@ -380,7 +380,7 @@ TEST(TpfAlgorithm1, ReinitialisesOnlyAboveThresholdAndOnlyForIdentifying) {
   TopologicalParticleFilter f(map, staticParams(1000), 1);
   ASSERT_TRUE(f.update(obsAt(0.0, {10}, {1.0})).ok());
   ASSERT_EQ(f.belief().map_node, 10u);
-  // Non-identifying observation far away: JSD = 1 but no re-initialisation; no overlap -> particles kept.
+  // Non-identifying observation far away: JSD = 1 but no re-initialisation; no overlap -> equal weights.
   auto r = f.update(obsAt(1.0, {100}, {1.0}, false, "lidar"));
   EXPECT_TRUE(r.ok());
   EXPECT_FALSE(r.reinitialised);
@@ -438,6 +438,29 @@ TEST(TpfAlgorithm1, EntropyGateSwitchesUnconnectedJumpsOff) {
   ASSERT_TRUE(g.update(obsAt(0.0, {12}, {1.0})).ok());
   EXPECT_LT(g.belief().entropy, 0.6);
   EXPECT_EQ(g.belief().unconnected_jump_probability, 1e-3);
+}
+
+TEST(TpfAlgorithm1, WrongLaneInitialisationRecoveryByMethod) {
+  // Khan et al.'s failure case: initialised in lane 2, the picker is in lane 8 (GNSS exact from then on).
+  // TPF: the JSD monitor re-initialises at once. Khan connected: the particles cannot leave lane 2 in 30 s.
+  // Khan unconnected: a particle jumping anywhere (p_rj) eventually lands under the GNSS likelihood.
+  auto map = polytunnel();
+  const NodeIndex wrong = *map->index("r2_5"), right = *map->index("r8_5");
+  auto run = [&](const std::string& method, int updates) {
+    TpfParams p = TpfParams::presetForMethod(method);
+    TopologicalParticleFilter f(map, p, 5);
+    EXPECT_TRUE(f.update(obsAt(0.0, {wrong}, {1.0})).ok());
+    for (int k = 1; k <= updates; ++k) {
+      core::Observation o = obsAt(k, {}, {});
+      core::setGaussianLikelihood(o, *map, map->position2d(right), 0.25 * Eigen::Matrix2d::Identity());
+      EXPECT_TRUE(f.update(o).ok());
+    }
+    return map->lane(f.belief().map_node) == map->lane(right);
+  };
+  EXPECT_TRUE(run("tpf", 1));
+  EXPECT_FALSE(run("khan_connected", 30));
+  EXPECT_FALSE(run("no_monitor", 30));
+  EXPECT_TRUE(run("khan_unconnected", 600));
 }
 
 // ------------------------------------------------------------------------------------------ bad input ------

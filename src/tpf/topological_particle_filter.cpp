@@ -448,12 +448,11 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
     result.reinitialised = true;
     ++counters_.reinitialisations;
   }
-  const bool resampled = weightAndResample(obs, max_l);  // Alg. 1 l. 10-11
+  const bool overlap = weightAndResample(obs, max_l);  // Alg. 1 l. 10-11
   for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
-  if (!resampled) {
+  if (!overlap) {
     ++counters_.no_overlap;
-    result.reason = "no overlap between the observation and the particles: kept the predicted particles";
-    recordBelief(false);
+    result.reason = "no overlap between the observation and the particles: resampled with equal weights";
   }
   // Alg. 1 l. 12-15
   if (params_.entropy_gate && belief_.entropy < params_.entropy_threshold) unconnected_p_ = 0.0;
@@ -462,7 +461,7 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
 
 bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood) {
   // Eq. 8 per particle (as particleWeight(), constants hoisted) with the Eq. 9 masses accumulated in
-  // node_scratch_b_ in the same pass; Eq. 10 MAP.
+  // node_scratch_b_ in the same pass; Eq. 10 MAP; Eqs. 11-12. Returns false when every weight was 0.
   const double inv_max = 1.0 / max_likelihood;
   const SensorGamma gamma = params_.gammaFor(obs.sensor);
   const bool velocity_term =
@@ -501,9 +500,14 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
                      static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f))));
     }
   }
-  if (!(total > 0.0) || !std::isfinite(total)) {
+  const bool overlap = total > 0.0 && std::isfinite(total);
+  if (!overlap) {
+    // The observation says nothing about where these particles are: equal weights, so resampling keeps the
+    // set (up to the Eq. 12 noise, which still lets particles jump to unconnected nodes with p_rj).
     for (NodeIndex n : touched_) mass[n] = 0.0;
-    return false;
+    touched_.clear();
+    total = 0.0;
+    for (std::size_t i = 0; i < particles_.size(); ++i) accumulate(i, particles_[i].node, 1.0);
   }
   std::sort(touched_.begin(), touched_.end());
   belief_.nodes.assign(touched_.begin(), touched_.end());
@@ -531,7 +535,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   }
   belief_.entropy = h;
   belief_.particle_count = particles_.size();
-  return true;
+  return overlap;
 }
 
 void TopologicalParticleFilter::resample(double total) {

@@ -34,8 +34,9 @@
 //  * Eq. 8: L enters normalised to its maximum (likelihood scale is arbitrary, see core::Observation), the
 //    Gaussian g is unnormalised (peak 1) with sigma = max(|v^s|/2, min_velocity_sigma); w_v = 0 when the
 //    observation carries no velocity.
-//  * All weights zero (support disjoint from the particles, no velocity): no weighting or resampling, the
-//    predicted particles are kept, status kAccepted with reason "no overlap".
+//  * All weights zero (support disjoint from the particles, no velocity): equal weights instead, so the
+//    predicted particles are kept up to the Eq. 12 noise (unconnected jumps with p_rj still happen, which is
+//    how Khan's unconnected variant recovers from a wrong lane); status kAccepted, reason "no overlap".
 //  * JSD (base-2 logs, so in [0, 1]) and entropy H (nats) over the support present. p_rj follows Algorithm 1:
 //    set to unconnected_jump_probability at start and on re-initialisation, to 0 once H < epsilon_H.
 //  * Eq. 12 velocity noise: inverse-transform sampling on a 4,096-quantile grid of N(0, 1) (speed; see code).
@@ -163,7 +164,7 @@ class TopologicalParticleFilter {
   void initialise(const core::Observation& obs);
   void predict(double dt);
   double observationJsd(const core::Observation& obs, double max_likelihood);
-  bool weightAndResample(const core::Observation& obs, double max_likelihood);
+  bool weightAndResample(const core::Observation& obs, double max_likelihood);  // false: no overlap
   void resample(double total_weight);
   void addNoise();
   void recordBelief(bool counted);
