@@ -23,3 +23,12 @@ install(TARGETS picker_localisation_nbs_ros
 
 pl_add_node(nbs_planner src/nodes/nbs_planner_node.cpp)
 target_link_libraries(nbs_planner picker_localisation_nbs_ros)
+
+# Benchmark: one plan with the TPF what-if, the Choquet integral.
+if(benchmark_FOUND)
+  add_executable(bench_nbs src/tools/bench_nbs.cpp)
+  target_link_libraries(bench_nbs picker_localisation_nbs benchmark::benchmark)
+  target_compile_definitions(bench_nbs PRIVATE PL_NBS_MAP="${CMAKE_CURRENT_SOURCE_DIR}/config/maps/riseholme.tmap2")
+  set_target_properties(bench_nbs PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
+  install(TARGETS bench_nbs RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+endif()
