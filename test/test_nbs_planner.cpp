@@ -6,22 +6,14 @@
 #include <memory>
 
 #include "picker_localisation/nbs/next_best_sense_planner.h"
-#include "picker_localisation/topology/synthetic_map.h"
+#include "nbs_test_maps.h"
 
 using namespace picker_localisation;
 using namespace picker_localisation::nbs;
+using nbs_test::wideTunnels;
 using topology::NodeIndex;
 
 namespace {
-
-// 5 lanes 8 m apart (so a 3 m read region never spans two lanes), 10 nodes per lane 3 m apart.
-std::shared_ptr<const topology::TopologicalMap> wideTunnels() {
-  topology::PolytunnelSpec spec;
-  spec.lanes = 5;
-  spec.nodes_per_lane = 10;
-  spec.lane_spacing = 8.0;
-  return std::make_shared<const topology::TopologicalMap>(topology::makePolytunnelMap(spec));
-}
 
 NodeIndex laneNode(const topology::TopologicalMap& map, int lane, int k) {
   return map.laneNodes(map.lane(*map.index("r" + std::to_string(lane) + "_0")))[static_cast<std::size_t>(k)];
