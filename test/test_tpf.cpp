@@ -398,16 +398,56 @@ TEST(TpfAlgorithm1, ReinitialisesOnlyAboveThresholdAndOnlyForIdentifying) {
   EXPECT_TRUE(f.belief().reinitialised);
   EXPECT_EQ(f.belief().map_node, 100u);
   EXPECT_EQ(f.counters().reinitialisations, 1u);
-  // The same JSD (0.5579) re-initialises with a threshold of 0.5.
+  // The same JSD (0.5579) re-initialises with a threshold of 0.5 and the paper's rule alone; with the
+  // contradiction guard (default) it does not, the observation agreeing with the belief (mean L/max L = 1).
   TpfParams low = staticParams(1000);
   low.jsd_threshold = 0.5;
+  low.reinit_max_mean_likelihood = 1.0;
   TopologicalParticleFilter g(map, low, 1);
   ASSERT_TRUE(g.update(obsAt(0.0, {10}, {1.0})).ok());
   EXPECT_TRUE(g.update(obsAt(1.0, {10, 100}, {1.0, 1.0})).reinitialised);
+  low.reinit_max_mean_likelihood = 0.1;
+  TopologicalParticleFilter g2(map, low, 1);
+  ASSERT_TRUE(g2.update(obsAt(0.0, {10}, {1.0})).ok());
+  EXPECT_FALSE(g2.update(obsAt(1.0, {10, 100}, {1.0, 1.0})).reinitialised);
+  // ... but does with L^ = 0.05 at the belief's node (mean 0.05 < 0.1) and JSD > 0.5.
+  EXPECT_TRUE(g2.update(obsAt(2.0, {10, 100}, {0.05, 1.0})).reinitialised);
   // jsd_monitor off (no_monitor): never.
   TopologicalParticleFilter h(map, TpfParams::presetForMethod("no_monitor", staticParams(1000)), 1);
   ASSERT_TRUE(h.update(obsAt(0.0, {10}, {1.0})).ok());
   EXPECT_FALSE(h.update(obsAt(1.0, {100}, {1.0})).reinitialised);
+}
+
+TEST(TpfAlgorithm1, FlatNegativeInformationDoesNotReinitialise) {
+  // RFID "not read here": L = 0.1 at five nodes near the antenna, 1 at every other node. Against a belief
+  // concentrated on node 10 the JSD is ~0.98 > 0.975, but the observation agrees with the belief (mean L/max L
+  // over the particles = 1): no re-initialisation, the belief stays on node 10. With the guard off
+  // (reinit_max_mean_likelihood = 1, the paper's rule alone) it re-initialises over the whole map.
+  auto map = polytunnel();
+  auto negative = [&](double stamp) {
+    core::Observation o = obsAt(stamp, {}, {}, true, "rfid");
+    for (NodeIndex n = 0; n < map->numNodes(); ++n) {
+      o.nodes.push_back(n);
+      o.likelihood.push_back(n >= 100 && n < 105 ? 0.1 : 1.0);
+    }
+    return o;
+  };
+  for (double guard : {0.1, 1.0}) {
+    TpfParams p = staticParams(1000);
+    p.reinit_max_mean_likelihood = guard;
+    TopologicalParticleFilter f(map, p, 1);
+    ASSERT_TRUE(f.update(obsAt(0.0, {10}, {1.0})).ok());
+    const auto r = f.update(negative(1.0));
+    EXPECT_GT(f.belief().jsd, 0.975);
+    if (guard < 1.0) {
+      EXPECT_FALSE(r.reinitialised);
+      EXPECT_EQ(f.belief().map_node, 10u);
+      EXPECT_NEAR(f.belief().massOf(10), 1.0, 1e-12);
+    } else {
+      EXPECT_TRUE(r.reinitialised);
+      EXPECT_GT(f.belief().nodes.size(), 100u);
+    }
+  }
 }
 
 TEST(TpfAlgorithm1, EntropyGateSwitchesUnconnectedJumpsOff) {

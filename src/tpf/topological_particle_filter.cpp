@@ -413,21 +413,24 @@ void TopologicalParticleFilter::predict(double dt) {
   }
 }
 
-double TopologicalParticleFilter::observationJsd(const core::Observation& obs, double sum_likelihood) {
-  // JSD between the particles' node distribution Q and L / sum L over their joint support, in O(support).
-  // node_scratch_b_ / touched_ hold the predicted particle counts left by predict() (cleared here).
+double TopologicalParticleFilter::observationJsd(const core::Observation& obs, double sum_likelihood,
+                                                 double max_likelihood, double* mean_likelihood) {
+  // JSD between the particles' node distribution Q and L / sum L over their joint support, in O(support),
+  // and the mean of L / max L over the particles. node_scratch_b_ / touched_ hold the predicted particle
+  // counts left by predict() (cleared here); node_scratch_a_ holds L (raw) at the observation's nodes.
   std::vector<double>& count = node_scratch_b_;
   const double inv_n = 1.0 / static_cast<double>(particles_.size());
   auto term = [](double x, double y) { return x > 0.0 ? x * std::log2(2.0 * x / (x + y)) : 0.0; };
-  double s = 0.0;
-  // node_scratch_a_ holds L (raw) at the observation's nodes.
+  double s = 0.0, mean = 0.0;
   for (NodeIndex n : touched_) {
     const double q = count[n] * inv_n, l = node_scratch_a_[n] / sum_likelihood;
     s += term(q, l) + term(l, q);
+    mean += q * node_scratch_a_[n] / max_likelihood;
   }
   for (std::size_t j = 0; j < obs.nodes.size(); ++j)
     if (count[obs.nodes[j]] == 0.0) s += obs.likelihood[j] / sum_likelihood;  // q = 0: l log2(2) = l
   for (NodeIndex n : touched_) count[n] = 0.0;
+  if (mean_likelihood) *mean_likelihood = mean;
   return std::sqrt(std::clamp(0.5 * s, 0.0, 1.0));
 }
 
@@ -440,9 +443,14 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
     sum_l += obs.likelihood[j];
     max_l = std::max(max_l, obs.likelihood[j]);
   }
-  belief_.jsd = observationJsd(obs, sum_l);  // Alg. 1 l. 5
+  double mean_l = 0.0;
+  belief_.jsd = observationJsd(obs, sum_l, max_l, &mean_l);  // Alg. 1 l. 5
   belief_.reinitialised = false;
-  if (params_.jsd_monitor && obs.identifying && belief_.jsd > params_.jsd_threshold && !result.initialised) {
+  // Alg. 1 l. 6, with the guard that the observation must contradict the particles (mean L / max L below
+  // reinit_max_mean_likelihood): a flat, negative-information likelihood ("not near this antenna") is far
+  // from a concentrated belief in JSD yet agrees with it, and must not spread the belief over the map.
+  if (params_.jsd_monitor && obs.identifying && belief_.jsd > params_.jsd_threshold && !result.initialised &&
+      (mean_l < params_.reinit_max_mean_likelihood || params_.reinit_max_mean_likelihood >= 1.0)) {
     initialise(obs);  // Alg. 1 l. 6-9 (initialise() sets p_rj back to its initial value, l. 8)
     belief_.reinitialised = true;
     result.reinitialised = true;

@@ -51,6 +51,8 @@ std::string TpfParams::validate() const {
       (gamma_as_confidence && default_gamma.node > 1.0))
     return "default_gamma must be finite and >= 0";
   if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0)) return "jsd_threshold must be in [0, 1]";
+  if (!(reinit_max_mean_likelihood > 0.0 && reinit_max_mean_likelihood <= 1.0))
+    return "reinit_max_mean_likelihood must be in (0, 1]";
   if (!finite_nonneg(entropy_threshold)) return "entropy_threshold must be >= 0";
   if (!(unconnected_jump_probability >= 0.0 && unconnected_jump_probability <= 1.0))
     return "unconnected_jump_probability must be in [0, 1]";
@@ -143,6 +145,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "accepted_sensors", p.accepted_sensors);
   read(node, "jsd_monitor", p.jsd_monitor);
   read(node, "jsd_threshold", p.jsd_threshold);
+  read(node, "reinit_max_mean_likelihood", p.reinit_max_mean_likelihood);
   read(node, "entropy_gate", p.entropy_gate);
   read(node, "entropy_threshold", p.entropy_threshold);
   read(node, "unconnected_jump_probability", p.unconnected_jump_probability);

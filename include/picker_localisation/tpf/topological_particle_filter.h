@@ -37,6 +37,11 @@
 //  * All weights zero (support disjoint from the particles, no velocity): equal weights instead, so the
 //    predicted particles are kept up to the Eq. 12 noise (unconnected jumps with p_rj still happen, which is
 //    how Khan's unconnected variant recovers from a wrong lane); status kAccepted, reason "no overlap".
+//  * JSD re-initialisation (Alg. 1 l. 6) also requires the observation to contradict the particles: the mean
+//    of L / max L over the predicted particles below reinit_max_mean_likelihood (0.1). A flat
+//    negative-information likelihood (RFID "not read here": 1 - p_detect near the antenna, 1 elsewhere) has
+//    JSD ~0.98 to a concentrated belief although it agrees with it; re-initialising from it would spread the
+//    belief over the whole map. 1.0 = the paper's rule (JSD alone).
 //  * JSD (base-2 logs, so in [0, 1]) and entropy H (nats) over the support present. p_rj follows Algorithm 1:
 //    set to unconnected_jump_probability at start and on re-initialisation, to 0 once H < epsilon_H.
 //  * Eq. 12 velocity noise: inverse-transform sampling on a 4,096-quantile grid of N(0, 1) (speed; see code).
@@ -163,7 +168,8 @@ class TopologicalParticleFilter {
   UpdateResult reject(UpdateStatus status, std::string reason);
   void initialise(const core::Observation& obs);
   void predict(double dt);
-  double observationJsd(const core::Observation& obs, double max_likelihood);
+  double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
+                        double* mean_likelihood);
   bool weightAndResample(const core::Observation& obs, double max_likelihood);  // false: no overlap
   void resample(double total_weight);
   void addNoise();

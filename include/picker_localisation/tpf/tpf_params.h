@@ -79,6 +79,9 @@ struct TpfParams {
   // ---------------------------------------------------------------------------------
   bool jsd_monitor = true;         // re-initialise when JSD > jsd_threshold on an identifying observation
   double jsd_threshold = 0.975;    // epsilon_JSD, [0, 1]
+  // Re-initialise only if, in addition, the mean of L / max L over the predicted particles is below this
+  // (the observation contradicts the belief; a flat negative-information likelihood does not). 1: JSD alone.
+  double reinit_max_mean_likelihood = 0.1;
   bool entropy_gate = true;        // set p_rj to 0 once the entropy drops below entropy_threshold
   double entropy_threshold = 0.6;  // epsilon_H, nats
   double unconnected_jump_probability = 1e-3;  // p_rj at start and after each re-initialisation (Alg. 1 l. 8)
