@@ -33,11 +33,11 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   int min_points = static_cast<int>(lo.segmentation.min_points);
   pnh_.param("min_cluster_points", min_points, min_points);
   lo.segmentation.min_points = static_cast<std::size_t>(std::max(1, min_points));
-  sensors::ClusterTrackerOptions to;
+  auto& to = tracker_options_;
   pnh_.param("gate_distance", to.gate_distance, to.gate_distance);
   pnh_.param("hits_to_confirm", to.hits_to_confirm, to.hits_to_confirm);
   pnh_.param("misses_to_delete", to.misses_to_delete, to.misses_to_delete);
-  tracker_ = sensors::ClusterTracker(to);
+  pnh_.param("tentative_misses", to.tentative_misses, to.tentative_misses);
   sensors::LidarCameraFusionOptions fo;
   pnh_.param("promote_after", fo.promote_after, fo.promote_after);
   pnh_.param("demote_after", fo.demote_after, fo.demote_after);
@@ -122,7 +122,7 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
     const Eigen::Vector3d q = tf * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
     people.push_back({q.head<2>(), p.confidence, "lidar"});
   }
-  publishPeople(msg->header.stamp, std::move(people));
+  publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
 }
 
 void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
@@ -142,7 +142,7 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
   for (auto& p : cloud.points) p.getVector3fMap() = tff * p.getVector3fMap();
   std::vector<PersonCandidate> people;
   for (const auto& p : cloud_detector_.detect(cloud)) people.push_back({p.centroid.head<2>(), p.confidence, "lidar3d"});
-  publishPeople(msg->header.stamp, std::move(people));
+  publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
 }
 
 void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
@@ -152,10 +152,17 @@ void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetec
 
 void LegDetectorNode::cameraInfoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg) { camera_info_ = msg; }
 
-void LegDetectorNode::publishPeople(const ros::Time& stamp, std::vector<PersonCandidate> people) {
+void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::Time& stamp,
+                                    std::vector<PersonCandidate> people) {
   std::vector<Eigen::Vector2d> positions;
   for (const auto& p : people) positions.push_back(p.position);
-  const auto& tracks = tracker_.update(stamp.toSec(), positions);
+  auto tracker = trackers_.find(source_frame);
+  if (tracker == trackers_.end()) {
+    auto o = tracker_options_;
+    o.first_id = static_cast<int>(trackers_.size()) * 1000000;
+    tracker = trackers_.emplace(source_frame, sensors::ClusterTracker(o)).first;
+  }
+  const auto& tracks = tracker->second.update(stamp.toSec(), positions);
   std::vector<int> track_of(people.size(), -1);
   std::vector<bool> confirmed(people.size(), false);
   for (const auto& t : tracks)
@@ -250,7 +257,9 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("people published", people_);
   stat.add("camera-confirmed people", fused_);
   stat.add("observations published", observations_);
-  stat.add("live tracks", tracker_.tracks().size());
+  std::size_t live = 0;
+  for (const auto& t : trackers_) live += t.second.tracks().size();
+  stat.add("live tracks", live);
   stat.add("last input stamp", last_input_.toSec());
 }
 

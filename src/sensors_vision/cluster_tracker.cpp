@@ -7,7 +7,7 @@
 namespace picker_localisation {
 namespace sensors {
 
-ClusterTracker::ClusterTracker(ClusterTrackerOptions options) : options_(options) {}
+ClusterTracker::ClusterTracker(ClusterTrackerOptions options) : options_(options), next_id_(options.first_id) {}
 
 void ClusterTracker::reset() {
   tracks_.clear();

@@ -12,6 +12,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,7 +44,7 @@ class LegDetectorNode {
   bool lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
               Eigen::Isometry3d& out);
   // Tracks, fuses and publishes the people of one scan / cloud (positions in the fixed frame).
-  void publishPeople(const ros::Time& stamp, std::vector<PersonCandidate> people);
+  void publishPeople(const std::string& source_frame, const ros::Time& stamp, std::vector<PersonCandidate> people);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
@@ -53,7 +54,10 @@ class LegDetectorNode {
   bool require_confirmed_ = true;
   std::unique_ptr<sensors::LegDetector> legs_;
   sensors::Cloud3dPersonDetector cloud_detector_;
-  sensors::ClusterTracker tracker_;
+  // One tracker per sensor frame: each laser sees only its own field of view, so a person outside it must not
+  // count as a miss of the other laser's track. Ids are kept disjoint (first_id = k * 1000000).
+  sensors::ClusterTrackerOptions tracker_options_;
+  std::map<std::string, sensors::ClusterTracker> trackers_;
   sensors::LidarCameraFusion fusion_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   tf2_ros::Buffer tf_buffer_;

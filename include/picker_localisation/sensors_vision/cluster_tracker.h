@@ -17,6 +17,7 @@ struct ClusterTrackerOptions {
   int misses_to_delete = 5;     // T_o: scans without an update before a track is removed
   int tentative_misses = 1;     // a tentative track missing this many scans is dropped at once
   double velocity_smoothing = 0.5;  // weight of the newest finite-difference velocity (0..1]
+  int first_id = 0;             // ids are first_id, first_id + 1, ... (several trackers can keep ids disjoint)
 };
 
 struct ClusterTrack {
@@ -34,6 +35,7 @@ struct ClusterTrack {
 class ClusterTracker {
  public:
   explicit ClusterTracker(ClusterTrackerOptions options = {});
+  const ClusterTrackerOptions& options() const { return options_; }
 
   // One step with the detections of one scan at `stamp`. Stamps going backwards reset nothing but are not
   // used for velocity. Returns every live track (confirmed or not) after the step.
