@@ -2,6 +2,7 @@
 // static map -> right_laser transform; the node must publish people near the labelled legs (in the map frame)
 // and non-identifying lidar Observations; an empty scan and a scan in a frame without tf must not kill it.
 #include <gtest/gtest.h>
+#include <picker_localisation/BearingDetectionArray.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PersonDetectionArray.h>
 #include <ros/ros.h>
@@ -131,6 +132,49 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
   good.header.frame_id = "right_laser";
   pub.publish(good);
   EXPECT_TRUE(waitFor([&] { return rec.people.size() > before; }, 5.0)) << "leg_detector stopped publishing";
+
+  // Fusion (Algorithm 4): a camera bearing towards the labelled legs, stamped like the scan, promotes the nearest
+  // cluster in the cone to a camera-confirmed person ("lidar_camera", confidence >= 0.6) at the legs.
+  auto cam_pub = nh.advertise<picker_localisation::BearingDetectionArray>("camera/detections", 10);
+  ASSERT_TRUE(waitFor([&] { return cam_pub.getNumSubscribers() > 0; }, 10.0));
+  const std::size_t fusion_start = rec.people.size();
+  std::vector<std::size_t> fused_scan;
+  for (std::size_t i = 41; i < 61 && i < scans.size(); ++i) {
+    double mx = 0, my = 0;
+    for (const auto& l : labels[i]) {
+      mx += l.first / labels[i].size();
+      my += l.second / labels[i].size();
+    }
+    const ros::Time stamp = ros::Time::now();
+    picker_localisation::BearingDetectionArray cam;
+    cam.header.stamp = stamp;
+    cam.header.frame_id = "right_laser";
+    picker_localisation::BearingDetection b;
+    b.bearing = std::atan2(my, mx);
+    b.confidence = 0.9;
+    cam.detections.push_back(b);
+    cam_pub.publish(cam);
+    waitFor([] { return false; }, 0.05);
+    auto s = scans[i];
+    s.header.stamp = stamp;
+    s.header.frame_id = "right_laser";
+    pub.publish(s);
+    fused_scan.push_back(i);
+    waitFor([] { return false; }, 0.1);
+  }
+  ASSERT_TRUE(waitFor([&] { return rec.people.size() >= fusion_start + fused_scan.size(); }, 10.0));
+  std::size_t camera_near = 0;
+  for (std::size_t k = 0; k < fused_scan.size(); ++k)
+    for (const auto& d : rec.people[fusion_start + k].detections) {
+      if (d.sensor != "lidar_camera") continue;
+      EXPECT_GE(d.confidence, 0.6);
+      for (const auto& l : labels[fused_scan[k]])
+        if (std::hypot(d.position.x - (l.first + kOffsetX), d.position.y - (l.second + kOffsetY)) < 0.5) {
+          ++camera_near;
+          break;
+        }
+    }
+  EXPECT_GE(camera_near, fused_scan.size() / 2) << "camera-confirmed people at the labelled legs";
 }
 
 int main(int argc, char** argv) {

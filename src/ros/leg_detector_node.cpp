@@ -72,7 +72,9 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("detections_topic", detections_topic, detections_topic);
   pnh_.param("camera_info_topic", camera_info_topic, camera_info_topic);
   if (!cloud_topic.empty()) subs_.push_back(nh_.subscribe(cloud_topic, 2, &LegDetectorNode::cloudCallback, this));
-  if (!detections_topic.empty())
+  fusion_enabled_ = !detections_topic.empty();
+  pnh_.param("max_fusion_cluster_width", max_fusion_cluster_width_, max_fusion_cluster_width_);
+  if (fusion_enabled_)
     subs_.push_back(nh_.subscribe(detections_topic, 5, &LegDetectorNode::detectionsCallback, this));
   if (!camera_info_topic.empty())
     subs_.push_back(nh_.subscribe(camera_info_topic, 1, &LegDetectorNode::cameraInfoCallback, this));
@@ -120,7 +122,22 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   std::vector<PersonCandidate> people;
   for (const auto& p : detection.people) {
     const Eigen::Vector3d q = tf * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
-    people.push_back({q.head<2>(), p.confidence, "lidar"});
+    people.push_back({q.head<2>(), p.confidence, "lidar", true});
+  }
+  if (fusion_enabled_) {
+    // Every other cluster of person size is a fusion candidate too: a camera cone may promote it.
+    std::vector<char> used(detection.clusters.size(), 0);
+    for (const auto& p : detection.people) {
+      if (p.leg_a >= 0) used[detection.legs[p.leg_a].cluster_index] = 1;
+      if (p.leg_b >= 0) used[detection.legs[p.leg_b].cluster_index] = 1;
+    }
+    for (std::size_t i = 0; i < detection.clusters.size(); ++i) {
+      const auto& c = detection.clusters[i];
+      if (used[i] || (c.points.back() - c.points.front()).norm() > max_fusion_cluster_width_) continue;
+      const Eigen::Vector2d m = c.centroid();
+      const Eigen::Vector3d q = tf * Eigen::Vector3d(m.x(), m.y(), 0.0);
+      people.push_back({q.head<2>(), 0.0, "lidar", false});
+    }
   }
   publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
 }
@@ -141,7 +158,7 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
   const Eigen::Affine3f tff(tf.matrix().cast<float>());
   for (auto& p : cloud.points) p.getVector3fMap() = tff * p.getVector3fMap();
   std::vector<PersonCandidate> people;
-  for (const auto& p : cloud_detector_.detect(cloud)) people.push_back({p.centroid.head<2>(), p.confidence, "lidar3d"});
+  for (const auto& p : cloud_detector_.detect(cloud)) people.push_back({p.centroid.head<2>(), p.confidence, "lidar3d", true});
   publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
 }
 
@@ -212,6 +229,7 @@ void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::
   const double var = position_sigma_ * position_sigma_;
   for (std::size_t i = 0; i < people.size(); ++i) {
     const bool camera = fused[i].camera_confirmed;
+    if (!people[i].classified && !camera) continue;                   // plain cluster, not selected by a cone
     if (require_confirmed_ && !confirmed[i] && !camera) continue;  // hysteresis: spurious clusters stay out
     picker_localisation::PersonDetection d;
     d.position.x = people[i].position.x();

@@ -36,6 +36,8 @@ class LegDetectorNode {
     Eigen::Vector2d position;  // fixed frame
     double confidence;
     std::string sensor;
+    bool classified = true;  // false: a cluster not classified as a person, published only when a camera cone
+                             // selects it (Algorithm 4 promotes the nearest cluster in the cone)
   };
   void scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg);
   void cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg);
@@ -51,7 +53,8 @@ class LegDetectorNode {
   bool ok_ = false;
   std::string fixed_frame_ = "map", robot_id_;
   double tf_timeout_ = 0.1, position_sigma_ = 0.3, fusion_max_age_ = 0.5, cone_half_width_ = 0.1;
-  bool require_confirmed_ = true;
+  bool require_confirmed_ = true, fusion_enabled_ = false;
+  double max_fusion_cluster_width_ = 0.8;
   std::unique_ptr<sensors::LegDetector> legs_;
   sensors::Cloud3dPersonDetector cloud_detector_;
   // One tracker per sensor frame: each laser sees only its own field of view, so a person outside it must not
