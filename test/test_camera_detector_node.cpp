@@ -11,20 +11,14 @@
 #include <cmath>
 #include <functional>
 
+#include "vision_rostest_util.h"
+
+using vision_test::waitFor;
+
 namespace {
 
 std::vector<picker_localisation::BearingDetectionArray> received;
 void onDetections(const picker_localisation::BearingDetectionArray::ConstPtr& m) { received.push_back(*m); }
-
-bool waitFor(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
-}
 
 }  // namespace
 

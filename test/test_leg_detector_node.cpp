@@ -17,6 +17,10 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "vision_rostest_util.h"
+
+using vision_test::waitFor;
+
 namespace {
 
 constexpr double kOffsetX = 14.0, kOffsetY = -20.0;  // map -> right_laser translation (near the first node)
@@ -27,16 +31,6 @@ struct Recorder {
   void onPeople(const picker_localisation::PersonDetectionArray::ConstPtr& m) { people.push_back(*m); }
   void onObservation(const picker_localisation::Observation::ConstPtr& m) { observations.push_back(*m); }
 };
-
-bool waitFor(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
-}
 
 }  // namespace
 

@@ -1,0 +1,21 @@
+// Shared helper of the sensors_vision rostests.
+#pragma once
+
+#include <ros/ros.h>
+
+#include <functional>
+
+namespace vision_test {
+
+// Spins until done() holds or `seconds` of wall time have passed; returns done().
+inline bool waitFor(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return done();
+}
+
+}  // namespace vision_test
