@@ -46,8 +46,9 @@ TEST(Choquet, AdditiveMeasureIsWeightedSum) {
 }
 
 TEST(Choquet, MonotoneInEachCriterion) {
-  std::vector<FuzzyMeasure> measures{handMeasure(), PlannerConfig().measure(),
-                                     FuzzyMeasure::fromWeights({0.3, 0.1, 0.35, 0.25}, {{0, 3, -0.4}, {1, 2, 0.5}})};
+  std::vector<FuzzyMeasure> measures{
+      handMeasure(), PlannerConfig().measure(),
+      FuzzyMeasure::fromWeights({0.3, 0.1, 0.35, 0.25}, {{0, 3, -0.4}, {1, 2, 0.5}})};
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   for (const FuzzyMeasure& mu : measures) {
@@ -72,16 +73,17 @@ TEST(FuzzyMeasureFromWeights, TableIDefaultsAreAMonotoneMeasure) {
   const FuzzyMeasure mu = PlannerConfig().measure();
   ASSERT_EQ(mu.numCriteria(), 4u);
   EXPECT_EQ(FuzzyMeasure::checkMeasure(mu.values()), "");
-  const std::uint32_t td = 1u << kTravelDistance, st = 1u << kSensingTime, rf = 1u << kRfidGain, bs = 1u << kBattery;
+  const std::uint32_t td = 1u << kTravelDistance, st = 1u << kSensingTime, rf = 1u << kRfidGain,
+                      bs = 1u << kBattery;
   EXPECT_DOUBLE_EQ(mu(0), 0.0);
   EXPECT_NEAR(mu(td | st | rf | bs), 1.0, 1e-12);
   EXPECT_NEAR(mu(td), 0.3, 1e-12);
   EXPECT_NEAR(mu(st), 0.1, 1e-12);
   EXPECT_NEAR(mu(rf), 0.35, 1e-12);
   EXPECT_NEAR(mu(bs), 0.25, 1e-12);
-  EXPECT_NEAR(mu(rf | td), 0.3 + 0.35 + 0.1, 1e-12);   // synergy
-  EXPECT_NEAR(mu(td | bs), 0.3 + 0.25 - 0.1, 1e-12);   // redundancy
-  EXPECT_NEAR(mu(st | bs), 0.35, 1e-12);               // additive pair
+  EXPECT_NEAR(mu(rf | td), 0.3 + 0.35 + 0.1, 1e-12);  // synergy
+  EXPECT_NEAR(mu(td | bs), 0.3 + 0.25 - 0.1, 1e-12);  // redundancy
+  EXPECT_NEAR(mu(st | bs), 0.35, 1e-12);              // additive pair
 }
 
 TEST(FuzzyMeasureFromWeights, ClampAndClosureKeepItMonotone) {
@@ -103,10 +105,12 @@ TEST(FuzzyMeasureFromWeights, RejectsBadInput) {
   EXPECT_THROW(FuzzyMeasure::fromWeights({0.5, std::nan("")}), std::invalid_argument);
   EXPECT_THROW(FuzzyMeasure::fromWeights({0.5, 0.5}, {{0, 0, 0.1}}), std::invalid_argument);
   EXPECT_THROW(FuzzyMeasure::fromWeights({0.5, 0.5}, {{0, 2, 0.1}}), std::invalid_argument);
-  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.0, 0.6, 0.5}), std::invalid_argument);       // not 2^n
-  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.0, 0.6, 0.5, 0.4}), std::invalid_argument);  // not monotone, mu(all) != 1
+  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.0, 0.6, 0.5}), std::invalid_argument);  // not 2^n
+  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.0, 0.6, 0.5, 0.4}),
+               std::invalid_argument);  // not monotone, mu(all) != 1
   EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.0, 0.6, 0.7, 0.5}), std::invalid_argument);  // mu(all) != 1
-  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.1, 0.6, 0.7, 1.0}), std::invalid_argument);  // mu(empty) != 0
+  EXPECT_THROW(FuzzyMeasure::fromSubsetValues({0.1, 0.6, 0.7, 1.0}),
+               std::invalid_argument);  // mu(empty) != 0
   EXPECT_THROW(choquetIntegral({0.5, 0.5}, handMeasure()), std::invalid_argument);
 }
 
@@ -139,7 +143,8 @@ TEST(PlannerConfigYaml, ReadsKeysAndRejectsBadValues) {
   EXPECT_DOUBLE_EQ(c.rfid.read_range, 2.5);
   EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("policy: random")), std::runtime_error);
   EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("rfid: {p_detect: 1.5}")), std::runtime_error);
-  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("interactions: [{criteria: [speed, battery], bonus: 0.1}]")),
-               std::runtime_error);
+  EXPECT_THROW(
+      PlannerConfig::fromYaml(YAML::Load("interactions: [{criteria: [speed, battery], bonus: 0.1}]")),
+      std::runtime_error);
   EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("horizon_hops: lots")), std::runtime_error);
 }

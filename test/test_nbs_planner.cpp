@@ -1,12 +1,13 @@
 // Next-Best-Sense planner on synthetic polytunnels with static beliefs (StaticBeliefSource, exact Bayes): the
-// criteria against hand-computed values, the preference for an uncertain picker, the fleet rule, EstimatedNode.
+// criteria against hand-computed values, the preference for an uncertain picker, the fleet rule,
+// EstimatedNode.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <memory>
 
-#include "picker_localisation/nbs/next_best_sense_planner.h"
 #include "nbs_test_maps.h"
+#include "picker_localisation/nbs/next_best_sense_planner.h"
 
 using namespace picker_localisation;
 using namespace picker_localisation::nbs;
@@ -54,8 +55,8 @@ TEST(NbsPlanner, RfidGainMatchesHandComputation) {
   EXPECT_NEAR(at_a->raw[kTravelDistance], 0.0, 1e-12);
   // Sensing time with q = 0.5: min + 0.5 (1 - e^{-rT}) / r + 0.5 T, e^{-rT} = 1 - p.
   const double rate = -std::log(1 - p) / cfg.rfid.max_sensing_time;
-  EXPECT_NEAR(at_a->raw[kSensingTime], cfg.rfid.min_sensing_time + 0.5 * p / rate + 0.5 * cfg.rfid.max_sensing_time,
-              1e-12);
+  EXPECT_NEAR(at_a->raw[kSensingTime],
+              cfg.rfid.min_sensing_time + 0.5 * p / rate + 0.5 * cfg.rfid.max_sensing_time, 1e-12);
   // Battery: nothing driven, only sensing energy.
   const double joules = (cfg.energy.base_power + cfg.energy.sensing_power) * at_a->raw[kSensingTime];
   EXPECT_NEAR(at_a->raw[kBattery], 1.0 - joules / cfg.energy.capacity, 1e-12);
@@ -76,7 +77,8 @@ TEST(NbsPlanner, PrefersCandidateNearUncertainPicker) {
   auto map = wideTunnels();
   // Confident picker: all mass on one node of lane 0. Uncertain picker: spread over lane 4.
   StaticBeliefSource confident("confident", uniformOver(*map, {laneNode(*map, 0, 5)}));
-  StaticBeliefSource uncertain("uncertain", uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 4, 0)))));
+  StaticBeliefSource uncertain("uncertain",
+                               uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 4, 0)))));
   // The robot on the headland node of lane 2, equally far from both lanes.
   const NodeIndex robot = *map->index("H2");
   NextBestSensePlanner planner(map, PlannerConfig{});
@@ -110,7 +112,8 @@ TEST(NbsPlanner, HorizonAndBatteryReserveLimitCandidates) {
   cfg.horizon_hops = 0;
   const NextBestSensePlanner planner(map, cfg);
   const double joules_10m = cfg.energy.energy(10.0, cfg.rfid.min_sensing_time + cfg.rfid.max_sensing_time);
-  const PlanResult low = planner.plan(robot, cfg.energy.reserve + joules_10m / cfg.energy.capacity, {&picker});
+  const PlanResult low =
+      planner.plan(robot, cfg.energy.reserve + joules_10m / cfg.energy.capacity, {&picker});
   ASSERT_TRUE(low.ok());
   for (const Candidate& c : low.ranked) {
     EXPECT_GE(c.raw[kBattery], cfg.energy.reserve);
@@ -124,7 +127,8 @@ TEST(NbsPlanner, HorizonAndBatteryReserveLimitCandidates) {
 
 TEST(NbsFleet, TwoRobotsNeverShareAGoal) {
   auto map = wideTunnels();
-  StaticBeliefSource uncertain("uncertain", uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 2, 0)))));
+  StaticBeliefSource uncertain("uncertain",
+                               uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 2, 0)))));
   PlannerConfig cfg;
   const NextBestSensePlanner planner(map, cfg);
   // Both robots on the same node: without coordination they would pick the same goal.
@@ -140,7 +144,8 @@ TEST(NbsFleet, TwoRobotsNeverShareAGoal) {
   for (const Candidate& c : goals[1].plan.ranked) EXPECT_NE(c.node, goals[0].plan.ranked.front().node);
   // Claimed pickers: two uncertain pickers, the second robot serves the other one.
   StaticBeliefSource other("other", uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 4, 0)))));
-  const auto two = planFleet(planner, {{"robot_1", start, 1.0}, {"robot_2", start, 1.0}}, {&uncertain, &other});
+  const auto two =
+      planFleet(planner, {{"robot_1", start, 1.0}, {"robot_2", start, 1.0}}, {&uncertain, &other});
   ASSERT_TRUE(two[0].plan.ok() && two[1].plan.ok());
   EXPECT_NE(two[0].plan.ranked.front().target_picker, "");
   EXPECT_NE(two[1].plan.ranked.front().target_picker, "");

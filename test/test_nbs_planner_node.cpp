@@ -1,16 +1,16 @@
-// rostest of nbs_planner on the Riseholme map (test/nbs_planner.test): beliefs in, goals / candidates / markers
-// out, the fleet rule across two robots, the EstimatedNode policy, the what-if service path, and that the planner
-// subscribes to no ground-truth topic (asked of the ROS master).
+// rostest of nbs_planner on the Riseholme map (test/nbs_planner.test): beliefs in, goals / candidates /
+// markers out, the fleet rule across two robots, the EstimatedNode policy, the what-if service path, and that
+// the planner subscribes to no ground-truth topic (asked of the ROS master).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/WhatIf.h>
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <atomic>
@@ -61,9 +61,10 @@ picker_localisation::PickerBelief beliefMsg(const std::string& id, const tpf::Be
 bool whatIf(picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
   ++g_what_if_calls;
   std::lock_guard<std::mutex> lock(g_mutex);
-  const tpf::Belief b = req.with_observation
-                            ? g_filter->posteriorUnder(ros_adapter::fromMsg(req.observation, *g_map), req.horizon, req.seed)
-                            : g_filter->predictAhead(req.horizon, req.seed);
+  const tpf::Belief b =
+      req.with_observation
+          ? g_filter->posteriorUnder(ros_adapter::fromMsg(req.observation, *g_map), req.horizon, req.seed)
+          : g_filter->predictAhead(req.horizon, req.seed);
   res.success = true;
   res.belief = beliefMsg("picker_2", b);
   return true;
@@ -108,12 +109,16 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   for (const std::string& r : robots) subs.push_back(nh.subscribe("/" + r + "/goal", 5, goalCallback));
   subs.push_back(nh.subscribe("/robot_1/nbs_candidates", 1, markerCallback));
 
-  ASSERT_TRUE(waitFor([&] {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    return g_goals.size() == 3 && g_markers;
-  }, 60.0)) << "goals received: " << g_goals.size() << ", markers: " << g_markers;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        return g_goals.size() == 3 && g_markers;
+      },
+      60.0))
+      << "goals received: " << g_goals.size() << ", markers: " << g_markers;
   // Goals keep coming every planning period; take fresh ones after the what-if has been used.
-  ASSERT_TRUE(waitFor([] { return g_what_if_calls.load() > 0; }, 20.0)) << "the planner never called the what-if";
+  ASSERT_TRUE(waitFor([] { return g_what_if_calls.load() > 0; }, 20.0))
+      << "the planner never called the what-if";
   ros::WallDuration(2.5).sleep();
   std::map<std::string, picker_localisation::GoalNode> goals;
   {
@@ -163,26 +168,33 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   ASSERT_TRUE(client.call(srv));
   EXPECT_EQ(srv.response.nodes.size(), 5u);
 
-  // Bad input: a belief of a map we do not have (unknown node names) for picker_3 is rejected, planning goes on.
+  // Bad input: a belief of a map we do not have (unknown node names) for picker_3 is rejected, planning goes
+  // on.
   ros::Publisher b3 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_3/belief", 1, true);
   picker_localisation::PickerBelief bad;
   bad.picker_id = "picker_3";
   bad.nodes = {"NoSuchNode", "NotThisOneEither"};
   bad.masses = {0.5, std::nan("")};
   b3.publish(bad);
-  ASSERT_TRUE(waitFor([] {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    auto it = g_diagnostics.find("robot_1");
-    if (it == g_diagnostics.end()) return false;
-    for (const auto& kv : it->second.values)
-      if (kv.key == "beliefs rejected picker_3" && kv.value != "0") return true;
-    return false;
-  }, 15.0)) << "robot_1 diagnostics never counted the bad belief";
+  ASSERT_TRUE(waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        auto it = g_diagnostics.find("robot_1");
+        if (it == g_diagnostics.end()) return false;
+        for (const auto& kv : it->second.values)
+          if (kv.key == "beliefs rejected picker_3" && kv.value != "0") return true;
+        return false;
+      },
+      15.0))
+      << "robot_1 diagnostics never counted the bad belief";
   const ros::Time before = ros::Time::now();
-  ASSERT_TRUE(waitFor([&] {
-    std::lock_guard<std::mutex> lock(g_mutex);
-    return g_goals.at("robot_1").header.stamp > before;
-  }, 10.0)) << "robot_1 stopped planning after a bad belief";
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        return g_goals.at("robot_1").header.stamp > before;
+      },
+      10.0))
+      << "robot_1 stopped planning after a bad belief";
 
   // Missing tf: robot_4 publishes no goal and reports the missing pose.
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -212,9 +224,10 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
     EXPECT_TRUE(topics.count("/pickers/picker_1/belief")) << node;
     for (const std::string& t : topics) {
       EXPECT_EQ(t.find("ground_truth"), std::string::npos) << node << " subscribes to " << t;
-      const bool allowed = (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
-                           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
-                           t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
+      const bool allowed =
+          (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
+          (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
+          t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }
   }

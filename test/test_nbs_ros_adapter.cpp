@@ -1,5 +1,5 @@
-// nbs_planner's message side without a roscore: PickerBelief -> node masses (bad entries rejected and counted),
-// the what-if source falling back to the published belief when no service is there.
+// nbs_planner's message side without a roscore: PickerBelief -> node masses (bad entries rejected and
+// counted), the what-if source falling back to the published belief when no service is there.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -26,7 +26,8 @@ StaticBeliefSource::StaticBeliefSource(std::string picker_id, NodeMasses masses)
     return;
   }
   for (double& m : masses_) m /= total;
-  map_node_ = static_cast<topology::NodeIndex>(std::max_element(masses_.begin(), masses_.end()) - masses_.begin());
+  map_node_ =
+      static_cast<topology::NodeIndex>(std::max_element(masses_.begin(), masses_.end()) - masses_.begin());
 }
 
 NodeMasses StaticBeliefSource::posterior(double, const core::Observation& obs) {

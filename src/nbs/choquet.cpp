@@ -22,7 +22,8 @@ std::size_t criteriaFromSize(std::size_t size) {
 
 std::string FuzzyMeasure::checkMeasure(const std::vector<double>& values) {
   const std::size_t n = criteriaFromSize(values.size());
-  if (n == 0) return "a fuzzy measure needs 2^n values for 1 <= n <= 16 criteria, got " + std::to_string(values.size());
+  if (n == 0)
+    return "a fuzzy measure needs 2^n values for 1 <= n <= 16 criteria, got " + std::to_string(values.size());
   const std::uint32_t all = static_cast<std::uint32_t>(values.size() - 1);
   for (std::size_t s = 0; s < values.size(); ++s)
     if (!std::isfinite(values[s])) return "mu(" + std::to_string(s) + ") is not finite";
@@ -34,7 +35,8 @@ std::string FuzzyMeasure::checkMeasure(const std::vector<double>& values) {
       const std::uint32_t bit = 1u << i;
       if (!(s & bit) && values[s | bit] < values[s] - kTolerance) {
         std::ostringstream os;
-        os << "not monotone: mu(" << (s | bit) << ") = " << values[s | bit] << " < mu(" << s << ") = " << values[s];
+        os << "not monotone: mu(" << (s | bit) << ") = " << values[s | bit] << " < mu(" << s
+           << ") = " << values[s];
         return os.str();
       }
     }
@@ -55,7 +57,8 @@ FuzzyMeasure FuzzyMeasure::fromWeights(const std::vector<double>& weights,
     throw std::invalid_argument("FuzzyMeasure: need 1 to 16 criteria, got " + std::to_string(n));
   double total = 0.0;
   for (double w : weights) {
-    if (!std::isfinite(w) || w < 0.0) throw std::invalid_argument("FuzzyMeasure: weights must be finite and >= 0");
+    if (!std::isfinite(w) || w < 0.0)
+      throw std::invalid_argument("FuzzyMeasure: weights must be finite and >= 0");
     total += w;
   }
   if (total <= 0.0) throw std::invalid_argument("FuzzyMeasure: the weights sum to 0");
@@ -88,8 +91,8 @@ FuzzyMeasure FuzzyMeasure::fromWeights(const std::vector<double>& weights,
 double choquetIntegral(const std::vector<double>& utilities, const FuzzyMeasure& mu) {
   const std::size_t n = mu.numCriteria();
   if (utilities.size() != n)
-    throw std::invalid_argument("choquetIntegral: " + std::to_string(utilities.size()) + " utilities for a measure over " +
-                                std::to_string(n) + " criteria");
+    throw std::invalid_argument("choquetIntegral: " + std::to_string(utilities.size()) +
+                                " utilities for a measure over " + std::to_string(n) + " criteria");
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),

@@ -80,12 +80,15 @@ std::size_t criterionIndex(const std::string& name) {
   const auto& names = criterionNames();
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return i;
-  throw std::runtime_error("nbs config: unknown criterion '" + name + "' (expected travel_distance, sensing_time, rfid_gain or battery)");
+  throw std::runtime_error("nbs config: unknown criterion '" + name +
+                           "' (expected travel_distance, sensing_time, rfid_gain or battery)");
 }
 
 }  // namespace
 
-const char* toString(Policy p) { return p == Policy::kEstimatedNode ? "estimated_node" : "nbs"; }
+const char* toString(Policy p) {
+  return p == Policy::kEstimatedNode ? "estimated_node" : "nbs";
+}
 
 Policy policyFromString(const std::string& s) {
   if (s == "nbs" || s == "next_best_sense") return Policy::kNextBestSense;
@@ -98,7 +101,9 @@ const std::vector<std::string>& criterionNames() {
   return names;
 }
 
-double RfidSensingModel::readRate() const { return -std::log(1.0 - p_detect) / max_sensing_time; }
+double RfidSensingModel::readRate() const {
+  return -std::log(1.0 - p_detect) / max_sensing_time;
+}
 
 double RfidSensingModel::expectedSensingTime(double q) const {
   q = std::clamp(q, 0.0, 1.0);
@@ -109,7 +114,8 @@ double RfidSensingModel::expectedSensingTime(double q) const {
 }
 
 double EnergyModel::energy(double distance, double sensing_time) const {
-  return drive_energy_per_m * distance + base_power * (distance / speed + sensing_time) + sensing_power * sensing_time;
+  return drive_energy_per_m * distance + base_power * (distance / speed + sensing_time) +
+         sensing_power * sensing_time;
 }
 
 double EnergyModel::levelAfter(double level, double distance, double sensing_time) const {
@@ -142,7 +148,8 @@ std::string PlannerConfig::validate() const {
   if (!(energy.drive_energy_per_m >= 0.0 && energy.base_power >= 0.0 && energy.sensing_power >= 0.0))
     return "energy: drive_energy_per_m, base_power and sensing_power must be >= 0";
   if (!(energy.reserve >= 0.0 && energy.reserve < 1.0)) return "energy/reserve must be in [0, 1)";
-  if (!(claimed_picker_weight >= 0.0 && claimed_picker_weight <= 1.0)) return "claimed_picker_weight must be in [0, 1]";
+  if (!(claimed_picker_weight >= 0.0 && claimed_picker_weight <= 1.0))
+    return "claimed_picker_weight must be in [0, 1]";
   if (claim_exclusion_hops < 0) return "claim_exclusion_hops must be >= 0";
   return "";
 }
@@ -164,7 +171,8 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node) {
     c.interactions.clear();
     if (!inter.IsSequence()) throw std::runtime_error("nbs config: 'interactions' must be a list");
     for (const YAML::Node& item : inter) {
-      if (!item["criteria"] || !item["criteria"].IsSequence() || item["criteria"].size() != 2 || !item["bonus"])
+      if (!item["criteria"] || !item["criteria"].IsSequence() || item["criteria"].size() != 2 ||
+          !item["bonus"])
         throw std::runtime_error("nbs config: each entry of 'interactions' needs criteria: [a, b] and bonus");
       CriterionInteraction ci;
       ci.a = criterionIndex(item["criteria"][0].as<std::string>());
@@ -221,7 +229,8 @@ NextBestSensePlanner::NextBestSensePlanner(std::shared_ptr<const TopologicalMap>
   measure_ = config_.measure();
 }
 
-std::vector<NodeIndex> NextBestSensePlanner::candidateNodes(NodeIndex robot, const std::vector<Claim>& claims) const {
+std::vector<NodeIndex> NextBestSensePlanner::candidateNodes(NodeIndex robot,
+                                                            const std::vector<Claim>& claims) const {
   const std::size_t n = map_->numNodes();
   std::vector<bool> excluded(n, false);
   for (const Claim& c : claims) {
@@ -245,7 +254,8 @@ std::vector<NodeIndex> NextBestSensePlanner::candidateNodes(NodeIndex robot, con
 }
 
 PlanResult NextBestSensePlanner::plan(NodeIndex robot_node, double battery_level,
-                                      const std::vector<BeliefSource*>& pickers, const std::vector<Claim>& claims) const {
+                                      const std::vector<BeliefSource*>& pickers,
+                                      const std::vector<Claim>& claims) const {
   PlanResult result;
   result.policy = config_.policy;
   if (robot_node >= map_->numNodes()) {
@@ -256,8 +266,9 @@ PlanResult NextBestSensePlanner::plan(NodeIndex robot_node, double battery_level
     result.problem = "battery level is not finite";
     return result;
   }
-  return config_.policy == Policy::kEstimatedNode ? planEstimatedNode(robot_node, battery_level, pickers, claims)
-                                                  : planNextBestSense(robot_node, battery_level, pickers, claims);
+  return config_.policy == Policy::kEstimatedNode
+             ? planEstimatedNode(robot_node, battery_level, pickers, claims)
+             : planNextBestSense(robot_node, battery_level, pickers, claims);
 }
 
 PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double battery,
@@ -270,8 +281,9 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
   const std::vector<double> dist = pathLengthsFrom(*map_, robot);
   std::vector<NodeIndex> nodes = candidateNodes(robot, claims);
   if (config_.horizon_m > 0.0)
-    nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [&](NodeIndex c) { return dist[c] > config_.horizon_m; }),
-                nodes.end());
+    nodes.erase(
+        std::remove_if(nodes.begin(), nodes.end(), [&](NodeIndex c) { return dist[c] > config_.horizon_m; }),
+        nodes.end());
   if (nodes.empty()) {
     result.problem = "no reachable unclaimed candidate node";
     return result;
@@ -336,7 +348,8 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
       result.what_if_queries += 2;
       if (post_read.size() != n || post_none.size() != n) continue;
       // Expected information gain; clamped at 0 (it is >= 0 in expectation, particle noise can dip below).
-      const double g = std::max(0.0, entropy(prior) - p_read * entropy(post_read) - (1.0 - p_read) * entropy(post_none));
+      const double g =
+          std::max(0.0, entropy(prior) - p_read * entropy(post_read) - (1.0 - p_read) * entropy(post_none));
       gain += p.weight * g;
       if (p.weight * g > best_gain) {
         best_gain = p.weight * g;
@@ -356,8 +369,8 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     candidates.push_back(std::move(cand));
   }
   if (candidates.empty()) {
-    result.problem = "every candidate would leave the battery below the reserve (" + std::to_string(infeasible) +
-                     " candidates)";
+    result.problem = "every candidate would leave the battery below the reserve (" +
+                     std::to_string(infeasible) + " candidates)";
     return result;
   }
 
@@ -399,8 +412,9 @@ PlanResult NextBestSensePlanner::planEstimatedNode(NodeIndex robot, double batte
     }
   }
   if (!target) {
-    result.problem = config_.target_picker.empty() ? "no picker has a belief yet"
-                                                   : "target picker '" + config_.target_picker + "' has no belief yet";
+    result.problem = config_.target_picker.empty()
+                         ? "no picker has a belief yet"
+                         : "target picker '" + config_.target_picker + "' has no belief yet";
     return result;
   }
   // The estimated node itself, or, when another robot claimed it, the nearest unclaimed node to it. Every
@@ -467,15 +481,17 @@ std::vector<Claim> claimsFor(const std::string& robot_id, const std::vector<Clai
 
 std::vector<FleetGoal> planFleet(const NextBestSensePlanner& planner, std::vector<RobotState> robots,
                                  const std::vector<BeliefSource*>& pickers) {
-  std::stable_sort(robots.begin(), robots.end(),
-                   [](const RobotState& a, const RobotState& b) { return robotHasPriority(a.robot_id, b.robot_id); });
+  std::stable_sort(robots.begin(), robots.end(), [](const RobotState& a, const RobotState& b) {
+    return robotHasPriority(a.robot_id, b.robot_id);
+  });
   std::vector<FleetGoal> goals;
   std::vector<Claim> claims;
   for (const RobotState& r : robots) {
     FleetGoal g;
     g.robot_id = r.robot_id;
     g.plan = planner.plan(r.node, r.battery_level, pickers, claims);
-    if (g.plan.ok()) claims.push_back({r.robot_id, g.plan.ranked.front().node, g.plan.ranked.front().target_picker});
+    if (g.plan.ok())
+      claims.push_back({r.robot_id, g.plan.ranked.front().node, g.plan.ranked.front().target_picker});
     goals.push_back(std::move(g));
   }
   return goals;

@@ -19,10 +19,14 @@ namespace {
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
   XmlRpc::XmlRpcValue x = v;  // the accessors are non-const
   switch (x.getType()) {
-    case XmlRpc::XmlRpcValue::TypeBoolean: return YAML::Node(static_cast<bool>(x));
-    case XmlRpc::XmlRpcValue::TypeInt: return YAML::Node(static_cast<int>(x));
-    case XmlRpc::XmlRpcValue::TypeDouble: return YAML::Node(static_cast<double>(x));
-    case XmlRpc::XmlRpcValue::TypeString: return YAML::Node(static_cast<std::string>(x));
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return YAML::Node(static_cast<bool>(x));
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return YAML::Node(static_cast<int>(x));
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return YAML::Node(static_cast<double>(x));
+    case XmlRpc::XmlRpcValue::TypeString:
+      return YAML::Node(static_cast<std::string>(x));
     case XmlRpc::XmlRpcValue::TypeArray: {
       YAML::Node n(YAML::NodeType::Sequence);
       for (int i = 0; i < x.size(); ++i) n.push_back(toYaml(x[i]));
@@ -33,7 +37,8 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
       for (auto it = x.begin(); it != x.end(); ++it) n[it->first] = toYaml(it->second);
       return n;
     }
-    default: return YAML::Node();
+    default:
+      return YAML::Node();
   }
 }
 
@@ -111,9 +116,8 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     in->id = p.id;
     const std::size_t k = pickers_.size();
     in->sub = nh_.subscribe<picker_localisation::PickerBelief>(
-        "/pickers/" + p.id + "/belief", 5, [this, k](const picker_localisation::PickerBelief::ConstPtr& m) {
-          beliefCallback(k, m);
-        });
+        "/pickers/" + p.id + "/belief", 5,
+        [this, k](const picker_localisation::PickerBelief::ConstPtr& m) { beliefCallback(k, m); });
     if (use_what_if_ && config.policy == nbs::Policy::kNextBestSense)
       in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + p.id + "/what_if", true);
     pickers_.push_back(std::move(in));
@@ -129,7 +133,8 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
       peer_subs_.push_back(nh_.subscribe("/" + other + "/goal", 5, &NbsPlannerNode::peerGoalCallback, this));
   std::string battery_topic;
   pnh_.param<std::string>("battery_topic", battery_topic, "battery");
-  if (!battery_topic.empty()) battery_sub_ = nh_.subscribe(battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
+  if (!battery_topic.empty())
+    battery_sub_ = nh_.subscribe(battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
 
   goal_pub_ = nh_.advertise<picker_localisation::GoalNode>("goal", 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("nbs_candidates", 1, true);
@@ -151,7 +156,8 @@ void NbsPlannerNode::beliefCallback(std::size_t k, const picker_localisation::Pi
   const nbs::NodeMasses masses = massesFromBelief(*msg, *map_, &rejected);
   if (masses.empty() || msg->picker_id != in.id) {
     ++in.rejected;
-    ROS_WARN_THROTTLE(10.0, "%s: rejected a belief of %s (%s)", ros::this_node::getName().c_str(), in.id.c_str(),
+    ROS_WARN_THROTTLE(10.0, "%s: rejected a belief of %s (%s)", ros::this_node::getName().c_str(),
+                      in.id.c_str(),
                       msg->picker_id != in.id ? ("picker_id '" + msg->picker_id + "'").c_str()
                                               : "no node of this map with a valid mass");
     return;
@@ -162,7 +168,8 @@ void NbsPlannerNode::beliefCallback(std::size_t k, const picker_localisation::Pi
 }
 
 void NbsPlannerNode::peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
-  if (msg->robot_id.empty() || msg->robot_id == robot_id_ || (!msg->node.empty() && !map_->index(msg->node))) {
+  if (msg->robot_id.empty() || msg->robot_id == robot_id_ ||
+      (!msg->node.empty() && !map_->index(msg->node))) {
     ++peer_goals_rejected_;
     ROS_WARN_THROTTLE(10.0, "%s: ignored a goal of robot '%s' (node '%s' not in the map or bad robot id)",
                       ros::this_node::getName().c_str(), msg->robot_id.c_str(), msg->node.c_str());
@@ -213,8 +220,8 @@ void NbsPlannerNode::planOnce() {
         in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + in->id + "/what_if", true);
       client = &in->what_if;
     }
-    sources.push_back(std::make_unique<WhatIfBeliefSource>(in->id, map_, *in->belief, client,
-                                                           static_cast<std::uint32_t>(what_if_seed_), map_frame_));
+    sources.push_back(std::make_unique<WhatIfBeliefSource>(
+        in->id, map_, *in->belief, client, static_cast<std::uint32_t>(what_if_seed_), map_frame_));
     pointers.push_back(sources.back().get());
   }
   std::vector<nbs::Claim> goals;
@@ -332,8 +339,9 @@ bool NbsPlannerNode::getCandidates(picker_localisation::GetCandidates::Request& 
   if (!last_plan_) return true;  // no pose yet: empty answer (diagnostics say why)
   const nbs::PlanResult& plan = *last_plan_;
   res.criteria = plan.criteria;
-  const std::size_t n = req.max_candidates == 0 ? plan.ranked.size()
-                                                : std::min<std::size_t>(req.max_candidates, plan.ranked.size());
+  const std::size_t n = req.max_candidates == 0
+                            ? plan.ranked.size()
+                            : std::min<std::size_t>(req.max_candidates, plan.ranked.size());
   for (std::size_t i = 0; i < n; ++i) {
     res.nodes.push_back(map_->node(plan.ranked[i].node).name);
     res.utilities.push_back(plan.ranked[i].utility);
@@ -370,7 +378,8 @@ void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   else if (with_belief == 0 && planner_->config().policy == nbs::Policy::kEstimatedNode)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no picker belief received yet");
   else if (!last_what_if_error_.empty() && fallback_plans_ > 0 && last_plan_ && plans_ > 0)
-    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "planning without the what-if service: " + last_what_if_error_);
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 "planning without the what-if service: " + last_what_if_error_);
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "planning");
 }

@@ -9,8 +9,8 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg, const topology::TopologicalMap& map,
-                                 std::size_t* rejected) {
+nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg,
+                                 const topology::TopologicalMap& map, std::size_t* rejected) {
   nbs::NodeMasses m(map.numNodes(), 0.0);
   double total = 0.0;
   std::size_t bad = msg.nodes.size() != msg.masses.size() ? 1 : 0;
@@ -30,9 +30,10 @@ nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg, c
   return m;
 }
 
-WhatIfBeliefSource::WhatIfBeliefSource(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map,
-                                       const picker_localisation::PickerBelief& belief, ros::ServiceClient* client,
-                                       std::uint32_t seed, std::string frame_id)
+WhatIfBeliefSource::WhatIfBeliefSource(std::string picker_id,
+                                       std::shared_ptr<const topology::TopologicalMap> map,
+                                       const picker_localisation::PickerBelief& belief,
+                                       ros::ServiceClient* client, std::uint32_t seed, std::string frame_id)
     : id_(std::move(picker_id)),
       map_(std::move(map)),
       fallback_(id_, massesFromBelief(belief, *map_)),

@@ -1,5 +1,5 @@
-// bench_nbs: cost of one Next-Best-Sense plan (all candidates, the TPF what-if per candidate and picker) and of
-// the Choquet integral alone. Riseholme map when the package's copy is found, else a synthetic polytunnel.
+// bench_nbs: cost of one Next-Best-Sense plan (all candidates, the TPF what-if per candidate and picker) and
+// of the Choquet integral alone. Riseholme map when the package's copy is found, else a synthetic polytunnel.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>

@@ -1,8 +1,8 @@
-// What the Next-Best-Sense planner needs to know about one picker: its belief over the map's nodes, that belief
-// predicted ahead, and the posterior it would have after a hypothetical observation. In the planner this is the
-// Topological Particle Filter's what-if API (TpfBeliefSource in tpf_belief_source.h, the ROS node's WhatIf
-// service client); StaticBeliefSource is a motionless belief with an exact Bayes update, the fallback when no
-// what-if is available. ROS-free.
+// What the Next-Best-Sense planner needs to know about one picker: its belief over the map's nodes, that
+// belief predicted ahead, and the posterior it would have after a hypothetical observation. In the planner
+// this is the Topological Particle Filter's what-if API (TpfBeliefSource in tpf_belief_source.h, the ROS
+// node's WhatIf service client); StaticBeliefSource is a motionless belief with an exact Bayes update, the
+// fallback when no what-if is available. ROS-free.
 #pragma once
 
 #include <string>
@@ -28,13 +28,13 @@ class BeliefSource {
   virtual topology::NodeIndex estimatedNode() const = 0;
   // Node masses predicted `horizon` s (>= 0) ahead of the last update. Empty when no belief is available.
   virtual NodeMasses predicted(double horizon) = 0;
-  // Node masses after predicting `horizon` s and fusing the hypothetical observation `obs`; the live belief is
-  // untouched. Empty when not available.
+  // Node masses after predicting `horizon` s and fusing the hypothetical observation `obs`; the live belief
+  // is untouched. Empty when not available.
   virtual NodeMasses posterior(double horizon, const core::Observation& obs) = 0;
 };
 
-// A belief that does not move (predicted(h) is the belief for every h) and fuses an observation by Bayes' rule
-// on the node masses: p'(n) ~ p(n) L(n) (L(n) = 0 for nodes the observation does not list). When the
+// A belief that does not move (predicted(h) is the belief for every h) and fuses an observation by Bayes'
+// rule on the node masses: p'(n) ~ p(n) L(n) (L(n) = 0 for nodes the observation does not list). When the
 // observation has no support under the belief, the belief is returned unchanged.
 class StaticBeliefSource : public BeliefSource {
  public:

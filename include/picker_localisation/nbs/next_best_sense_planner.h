@@ -1,28 +1,29 @@
 // Next-Best-Sense planner (Navigate-and-Seek Sec. V): candidate robot goals on graph nodes, four criteria per
-// candidate, min-max normalisation, the discrete Choquet integral of Eq. 13, argmax. The EstimatedNode policy of
-// Sec. VI-B is a second policy of the same planner. Fleet coordination: see planFleet(). ROS-free.
+// candidate, min-max normalisation, the discrete Choquet integral of Eq. 13, argmax. The EstimatedNode policy
+// of Sec. VI-B is a second policy of the same planner. Fleet coordination: see planFleet(). ROS-free.
 //
 // Criteria of a candidate node c for a robot at node r (raw values; see README docs/readme/nbs.md):
 //  travel_distance [m], cost:   graph path length r -> c (Dijkstra on the undirected motion graph).
 //  sensing_time [s], cost:      expected duration of the sensing operation at c: the robot senses until a tag
 //                               is read or max_sensing_time elapses. A tag within read_range is read at the
-//                               Poisson rate r = -ln(1 - p_detect) / max_sensing_time (so it is read within the
-//                               window with probability p_detect); with q(c) = P(at least one picker within
-//                               read_range of c) under the predicted beliefs,
-//                               ST = min_sensing_time + q (1 - e^{-r T}) / r + (1 - q) T,  T = max_sensing_time.
+//                               Poisson rate r = -ln(1 - p_detect) / max_sensing_time (so it is read within
+//                               the window with probability p_detect); with q(c) = P(at least one picker
+//                               within read_range of c) under the predicted beliefs, ST = min_sensing_time +
+//                               q (1 - e^{-r T}) / r + (1 - q) T,  T = max_sensing_time.
 //  rfid_gain [nats], benefit:   expected entropy reduction of the pickers' beliefs by the sensing operation:
 //                               sum_k w_k [H(b_k) - P_k(read) H(b_k | read) - P_k(no read) H(b_k | no read)],
 //                               b_k the belief of picker k predicted to the arrival time (travel time
 //                               = travel_distance / speed), the posteriors from the BeliefSource what-if with
 //                               the RFID observations rfid_ranging would produce: read L(n) = 1 within
-//                               read_range of c, no read L(n) = 1 - p_detect within read_range and 1 elsewhere;
-//                               P_k(read) = p_detect * b_k(read region). w_k = 1, or claimed_picker_weight
-//                               when another robot of higher priority already serves picker k.
+//                               read_range of c, no read L(n) = 1 - p_detect within read_range and 1
+//                               elsewhere; P_k(read) = p_detect * b_k(read region). w_k = 1, or
+//                               claimed_picker_weight when another robot of higher priority already serves
+//                               picker k.
 //  battery [fraction], benefit: expected battery level after driving to c and sensing there (EnergyModel).
-// Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m metres,
-// minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them), minus the
-// nodes whose battery level on arrival would fall below energy.reserve. The robot's own node is a candidate
-// (stay and sense).
+// Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m
+// metres, minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them),
+// minus the nodes whose battery level on arrival would fall below energy.reserve. The robot's own node is a
+// candidate (stay and sense).
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -39,21 +40,27 @@ namespace picker_localisation {
 namespace nbs {
 
 enum class Policy { kNextBestSense, kEstimatedNode };
-const char* toString(Policy p);          // "nbs" | "estimated_node"
+const char* toString(Policy p);                 // "nbs" | "estimated_node"
 Policy policyFromString(const std::string& s);  // throws std::invalid_argument
 
 // Criterion order of every criteria vector, FuzzyMeasure and README table.
-enum Criterion : std::size_t { kTravelDistance = 0, kSensingTime = 1, kRfidGain = 2, kBattery = 3, kNumCriteria = 4 };
+enum Criterion : std::size_t {
+  kTravelDistance = 0,
+  kSensingTime = 1,
+  kRfidGain = 2,
+  kBattery = 3,
+  kNumCriteria = 4
+};
 const std::vector<std::string>& criterionNames();  // travel_distance, sensing_time, rfid_gain, battery
 
 // The RFID sensing the planner expects at a candidate; keep read_range / p_detect equal to rfid_ranging's
 // RfidModelOptions so the hypothetical observations are the ones the tracker will really receive.
 struct RfidSensingModel {
-  double read_range = 3.0;         // m, radius of the read region around the robot (both antennas together)
-  double p_detect = 0.7;           // probability that a tag inside the region is read within max_sensing_time
-  double min_sensing_time = 1.0;   // s, fixed cost of a stop (settling, one inventory round)
-  double max_sensing_time = 5.0;   // s, the robot gives up sensing after this long without a read
-  double readRate() const;         // 1/s, Poisson rate r of the header comment
+  double read_range = 3.0;        // m, radius of the read region around the robot (both antennas together)
+  double p_detect = 0.7;          // probability that a tag inside the region is read within max_sensing_time
+  double min_sensing_time = 1.0;  // s, fixed cost of a stop (settling, one inventory round)
+  double max_sensing_time = 5.0;  // s, the robot gives up sensing after this long without a read
+  double readRate() const;        // 1/s, Poisson rate r of the header comment
   // Expected sensing time given q = P(some picker within read_range), s.
   double expectedSensingTime(double q) const;
 };
@@ -75,19 +82,20 @@ struct EnergyModel {
 struct PlannerConfig {
   Policy policy = Policy::kNextBestSense;
   std::vector<double> weights{0.3, 0.1, 0.35, 0.25};  // Table I: TD, ST, RFID, BS (criterion order)
-  // Pair interactions of the fuzzy measure (FuzzyMeasure::fromWeights). Defaults: RFID gain with travel distance
-  // are synergic (an informative node that is also near is worth more than either), travel distance with
-  // battery are redundant (battery is mostly distance); the two cancel on the full set.
-  std::vector<CriterionInteraction> interactions{{kRfidGain, kTravelDistance, 0.1}, {kTravelDistance, kBattery, -0.1}};
-  int horizon_hops = 0;      // candidates at most this many hops away (0: no limit)
-  double horizon_m = 0.0;    // candidates at most this path length away, m (0: no limit)
-  double horizon_bucket = 2.0;  // s, arrival times are rounded to this step to share predictions
+  // Pair interactions of the fuzzy measure (FuzzyMeasure::fromWeights). Defaults: RFID gain with travel
+  // distance are synergic (an informative node that is also near is worth more than either), travel distance
+  // with battery are redundant (battery is mostly distance); the two cancel on the full set.
+  std::vector<CriterionInteraction> interactions{{kRfidGain, kTravelDistance, 0.1},
+                                                 {kTravelDistance, kBattery, -0.1}};
+  int horizon_hops = 0;           // candidates at most this many hops away (0: no limit)
+  double horizon_m = 0.0;         // candidates at most this path length away, m (0: no limit)
+  double horizon_bucket = 2.0;    // s, arrival times are rounded to this step to share predictions
   double planning_latency = 0.0;  // s added to every arrival time (belief age at planning)
   RfidSensingModel rfid;
   EnergyModel energy;
   double claimed_picker_weight = 0.0;  // w_k of a picker served by a higher-priority robot
   int claim_exclusion_hops = 0;        // nodes within this many hops of a claimed goal are excluded too
-  std::string target_picker;           // estimated_node: picker to reach ("" = first unclaimed, in input order)
+  std::string target_picker;  // estimated_node: picker to reach ("" = first unclaimed, in input order)
 
   FuzzyMeasure measure() const;  // throws std::invalid_argument on bad weights / interactions
   std::string validate() const;  // "" when valid
@@ -109,7 +117,7 @@ struct Candidate {
   std::vector<double> raw;         // criterion values in their units (criterionNames() order)
   std::vector<double> normalised;  // min-max normalised utilities in [0, 1]
   double utility = 0.0;            // Choquet integral (Eq. 13), [0, 1]
-  std::string target_picker;       // picker contributing most to rfid_gain (nbs) or the target (estimated_node)
+  std::string target_picker;  // picker contributing most to rfid_gain (nbs) or the target (estimated_node)
 };
 
 struct PlanResult {
@@ -127,20 +135,23 @@ class NextBestSensePlanner {
   NextBestSensePlanner(std::shared_ptr<const topology::TopologicalMap> map, PlannerConfig config);
 
   // Ranks the candidate goals of a robot at robot_node with battery_level in [0, 1]. `pickers` are what-if
-  // views of the pickers' trackers (non-owning, may be empty: rfid_gain is then 0 everywhere); `claims` are the
-  // goals of the robots with higher priority (see planFleet).
-  PlanResult plan(topology::NodeIndex robot_node, double battery_level, const std::vector<BeliefSource*>& pickers,
-                  const std::vector<Claim>& claims = {}) const;
+  // views of the pickers' trackers (non-owning, may be empty: rfid_gain is then 0 everywhere); `claims` are
+  // the goals of the robots with higher priority (see planFleet).
+  PlanResult plan(topology::NodeIndex robot_node, double battery_level,
+                  const std::vector<BeliefSource*>& pickers, const std::vector<Claim>& claims = {}) const;
 
   const PlannerConfig& config() const { return config_; }
   const topology::TopologicalMap& map() const { return *map_; }
 
  private:
-  PlanResult planNextBestSense(topology::NodeIndex robot, double battery, const std::vector<BeliefSource*>& pickers,
+  PlanResult planNextBestSense(topology::NodeIndex robot, double battery,
+                               const std::vector<BeliefSource*>& pickers,
                                const std::vector<Claim>& claims) const;
-  PlanResult planEstimatedNode(topology::NodeIndex robot, double battery, const std::vector<BeliefSource*>& pickers,
+  PlanResult planEstimatedNode(topology::NodeIndex robot, double battery,
+                               const std::vector<BeliefSource*>& pickers,
                                const std::vector<Claim>& claims) const;
-  std::vector<topology::NodeIndex> candidateNodes(topology::NodeIndex robot, const std::vector<Claim>& claims) const;
+  std::vector<topology::NodeIndex> candidateNodes(topology::NodeIndex robot,
+                                                  const std::vector<Claim>& claims) const;
 
   std::shared_ptr<const topology::TopologicalMap> map_;
   PlannerConfig config_;
@@ -150,8 +161,8 @@ class NextBestSensePlanner {
 // Fleet rule (documented in docs/readme/nbs.md): robots have priority in robot-id order (natural order, so
 // robot_2 < robot_10). Each robot plans with the goals of every higher-priority robot as claims: their goal
 // nodes are excluded from its candidates and the pickers they serve weigh claimed_picker_weight in its RFID
-// gain (estimated_node: it targets the first picker nobody claimed). Hence two robots never get the same goal,
-// and a lower-priority robot never makes a higher-priority one change its plan (no oscillation).
+// gain (estimated_node: it targets the first picker nobody claimed). Hence two robots never get the same
+// goal, and a lower-priority robot never makes a higher-priority one change its plan (no oscillation).
 struct RobotState {
   std::string robot_id;
   topology::NodeIndex node = topology::kInvalidNode;

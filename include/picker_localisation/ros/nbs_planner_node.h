@@ -1,10 +1,12 @@
-// nbs_planner: the Next-Best-Sense planner of one robot (Navigate-and-Seek Sec. V), run in the robot's namespace.
-// Subscribes /pickers/<id>/belief (ids from ~pickers_file), the goals of the other robots of the fleet
-// (/<robot_k>/goal) and, optionally, ~battery_topic; reads the robot pose from tf (map -> <robot_id>/base_link).
-// Every ~planning_period s of ROS time it plans (NextBestSensePlanner, policy nbs or estimated_node) and
-// publishes the goal on goal (GoalNode, latched) and the candidates' utilities on nbs_candidates (MarkerArray);
-// service get_candidates returns the ranked candidates. Predictions and hypothetical posteriors come from the
-// trackers' /pickers/<id>/what_if services. No ground-truth topic is read. Parameters: config/nbs.yaml.
+// nbs_planner: the Next-Best-Sense planner of one robot (Navigate-and-Seek Sec. V), run in the robot's
+// namespace. Subscribes /pickers/<id>/belief (ids from ~pickers_file), the goals of the other robots of the
+// fleet
+// (/<robot_k>/goal) and, optionally, ~battery_topic; reads the robot pose from tf (map ->
+// <robot_id>/base_link). Every ~planning_period s of ROS time it plans (NextBestSensePlanner, policy nbs or
+// estimated_node) and publishes the goal on goal (GoalNode, latched) and the candidates' utilities on
+// nbs_candidates (MarkerArray); service get_candidates returns the ranked candidates. Predictions and
+// hypothetical posteriors come from the trackers' /pickers/<id>/what_if services. No ground-truth topic is
+// read. Parameters: config/nbs.yaml.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -14,8 +16,8 @@
 
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
-#include <picker_localisation/WhatIf.h>
 #include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/WhatIf.h>
 #include <sensor_msgs/BatteryState.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -57,7 +59,8 @@ class NbsPlannerNode {
   void beliefCallback(std::size_t picker, const picker_localisation::PickerBelief::ConstPtr& msg);
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg);
-  bool getCandidates(picker_localisation::GetCandidates::Request& req, picker_localisation::GetCandidates::Response& res);
+  bool getCandidates(picker_localisation::GetCandidates::Request& req,
+                     picker_localisation::GetCandidates::Response& res);
   std::optional<topology::NodeIndex> robotNode();
   void publish(const nbs::PlanResult& plan, const ros::Time& stamp);
   visualization_msgs::MarkerArray candidateMarkers(const nbs::PlanResult& plan, const ros::Time& stamp) const;

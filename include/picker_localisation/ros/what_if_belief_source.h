@@ -1,8 +1,8 @@
 // BeliefSource (nbs/belief_source.h) for the nbs_planner node: the pickers' beliefs arrive as PickerBelief
 // messages; predictions and hypothetical posteriors come from the tracker's what-if service
 // (/pickers/<id>/what_if, picker_localisation/WhatIf: a copy of the live filter, the live one untouched).
-// When the service is not available or a call fails, the source falls back to the last published belief used as
-// a motionless belief with an exact Bayes update (StaticBeliefSource) and says so (usedFallback()).
+// When the service is not available or a call fails, the source falls back to the last published belief used
+// as a motionless belief with an exact Bayes update (StaticBeliefSource) and says so (usedFallback()).
 #pragma once
 
 #include <ros/ros.h>
@@ -18,15 +18,17 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-// Dense node masses of a PickerBelief message. Node names not in the map and non-finite or negative masses are
-// counted in *rejected (when given) and skipped; the rest is renormalised. Empty when nothing valid remains.
-nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg, const topology::TopologicalMap& map,
-                                 std::size_t* rejected = nullptr);
+// Dense node masses of a PickerBelief message. Node names not in the map and non-finite or negative masses
+// are counted in *rejected (when given) and skipped; the rest is renormalised. Empty when nothing valid
+// remains.
+nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg,
+                                 const topology::TopologicalMap& map, std::size_t* rejected = nullptr);
 
 class WhatIfBeliefSource : public nbs::BeliefSource {
  public:
-  // `client` may be null or not connected (then only the fallback is used). `seed` is sent with every query so
-  // the predicted belief and the hypothetical posteriors share the same prediction (common random numbers).
+  // `client` may be null or not connected (then only the fallback is used). `seed` is sent with every query
+  // so the predicted belief and the hypothetical posteriors share the same prediction (common random
+  // numbers).
   WhatIfBeliefSource(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map,
                      const picker_localisation::PickerBelief& belief, ros::ServiceClient* client,
                      std::uint32_t seed, std::string frame_id = "map");
