@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# `make demo`: runs the package's demo from the build tree (build/devel). RVIZ=1 opens rviz.
+# `make demo`: runs launch/demo.launch (the whole suite on the simulated Riseholme farm, headless, ending by
+# itself with the evaluator's error table) from the build tree (build/devel), on its own master port.
+# RVIZ=1 opens rviz; extra arguments are passed to roslaunch (e.g. robots:=2 duration:=120).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR="${BUILD_DIR:-build}"
@@ -9,8 +11,9 @@ export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
 source "$BUILD_DIR/devel/setup.bash"
 echo "== Riseholme topological map (config/maps/riseholme.tmap2) =="
 "$BUILD_DIR/devel/lib/picker_localisation/tmap_info" config/maps/riseholme.tmap2
-if [ "${RVIZ:-0}" = "1" ]; then
-  port=$((20000 + RANDOM % 20000))   # own master port: never collides with a running roscore
-  export ROS_MASTER_URI="http://localhost:$port"
-  roslaunch -p "$port" picker_localisation map_view.launch
-fi
+port=$((20000 + RANDOM % 20000))   # own master port: never collides with a running roscore
+export ROS_MASTER_URI="http://localhost:$port"
+rviz=false
+[ "${RVIZ:-0}" = "1" ] && rviz=true
+echo "== demo.launch (master port $port, rviz $rviz) =="
+exec roslaunch -p "$port" picker_localisation demo.launch rviz:="$rviz" "$@"

@@ -1,0 +1,108 @@
+// rostest: the ROS node graph (farm_sim -> gnss_ingest / rfid_ranging / leg_detector -> tpf_tracker per picker ->
+// evaluator) against the offline runner (eval::runOnce, method rfid_lidar_gnss, scenario multi) on the same seed.
+//
+// Both simulate the same farm (same seed and config files: the pickers' walks and raw measurements are the
+// same), but they cannot agree sample by sample: in the graph, observations reach the trackers over topics in
+// arrival order with transport latency, periodic predictions fire on ROS timers, the evaluator samples the
+// latest belief on its own timer, and the trackers' particle filters draw from other seeds. So the test compares
+// the pooled mean errors over the run against the runner's mean over four tracker seeds, with tolerances
+// (kEuclideanTolerance, kTopologicalTolerance) a few times the spread between tracker seeds measured offline
+// (about 0.1 m and 0.4 nodes on 120 s) but far below what a wrong datum, frame or routing produces (metres,
+// several nodes).
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include "picker_localisation/TrackingError.h"
+#include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/eval/experiment.h"
+#include "picker_localisation/topology/map_io.h"
+
+using namespace picker_localisation;
+
+namespace {
+constexpr double kEuclideanTolerance = 1.0;    // m
+constexpr double kTopologicalTolerance = 2.0;  // nodes
+}  // namespace
+
+TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
+  ros::NodeHandle nh, pnh("~");
+  std::string map_file;
+  int seed = 3;
+  double duration = 120.0;
+  ASSERT_TRUE(pnh.getParam("map_file", map_file));
+  pnh.param("seed", seed, seed);
+  pnh.param("duration", duration, duration);
+  const auto registry = core::PickerRegistry::load(std::string(PL_PACKAGE_DIR) + "/config/pickers.yaml");
+  ASSERT_GE(registry.size(), 3u);
+
+  std::map<std::string, std::vector<picker_localisation::TrackingError>> errors;
+  std::vector<ros::Subscriber> subs;
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string id = registry.pickers()[i].id;
+    subs.push_back(nh.subscribe<picker_localisation::TrackingError>(
+        "/pickers/" + id + "/error", 100,
+        [&errors, id](const picker_localisation::TrackingError::ConstPtr& m) { errors[id].push_back(*m); }));
+  }
+  // The evaluator samples at 1 Hz for `duration` s of sim time after the first ground truth, then exits.
+  const std::size_t wanted = static_cast<std::size_t>(0.9 * duration);
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(280.0);
+  auto enough = [&] {
+    for (std::size_t i = 0; i < 3; ++i)
+      if (errors[registry.pickers()[i].id].size() < wanted) return false;
+    return true;
+  };
+  while (ros::ok() && !enough() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    ros::WallDuration(0.05).sleep();
+  }
+  ASSERT_TRUE(enough()) << "the graph produced too few error samples in time";
+
+  double graph_eu = 0.0, graph_topo = 0.0;
+  std::size_t n = 0, n_topo = 0;
+  for (const auto& [id, list] : errors) {
+    for (const auto& e : list) {
+      graph_eu += e.euclidean_error;
+      if (e.topological_error >= 0) {
+        graph_topo += e.topological_error;
+        ++n_topo;
+      }
+      ++n;
+    }
+  }
+  graph_eu /= static_cast<double>(n);
+  graph_topo /= static_cast<double>(n_topo);
+
+  auto map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(map_file));
+  eval::RunConfig rc;
+  rc.scenario = eval::Scenario::kMulti;
+  rc.method = "rfid_lidar_gnss";
+  rc.seed = static_cast<std::uint64_t>(seed);
+  rc.duration = duration;
+  ASSERT_EQ(eval::methodUnavailableReason(rc.method, rc), "");
+  double off_eu = 0.0, off_topo = 0.0;
+  const std::uint64_t tracker_seeds[] = {0, 101, 102, 103};
+  for (std::uint64_t ts : tracker_seeds) {
+    rc.tracker_seed = ts;
+    const eval::RunMetrics m = eval::summariseRun(eval::runOnce(map, rc).samples);
+    off_eu += m.euclidean_mean / 4.0;
+    off_topo += m.topological_mean / 4.0;
+  }
+  std::printf("graph: %zu samples, euclidean %.2f m, topological %.2f nodes; offline runner: euclidean %.2f m, "
+              "topological %.2f nodes\n", n, graph_eu, graph_topo, off_eu, off_topo);
+  RecordProperty("graph_euclidean", std::to_string(graph_eu));
+  RecordProperty("graph_topological", std::to_string(graph_topo));
+  RecordProperty("offline_euclidean", std::to_string(off_eu));
+  RecordProperty("offline_topological", std::to_string(off_topo));
+  EXPECT_NEAR(graph_eu, off_eu, kEuclideanTolerance);
+  EXPECT_NEAR(graph_topo, off_topo, kTopologicalTolerance);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_eval_graph_vs_runner");
+  return RUN_ALL_TESTS();
+}
