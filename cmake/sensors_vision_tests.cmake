@@ -11,3 +11,8 @@ target_link_libraries(test_leg_detector_node picker_localisation_ros)
 add_rostest_gtest(test_camera_detector_node test/camera_detector.test test/test_camera_detector_node.cpp)
 target_link_libraries(test_camera_detector_node picker_localisation_ros ${OpenCV_LIBS})
 target_include_directories(test_camera_detector_node SYSTEM PRIVATE ${OpenCV_INCLUDE_DIRS})
+# Offline tools: CSV headers and rows on real data, usage errors.
+add_test(NAME vision_tools_cli
+  COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/test/check_vision_tools.sh $<TARGET_FILE:bag_detect_legs>
+          $<TARGET_FILE:detect_people> ${CMAKE_CURRENT_SOURCE_DIR} ${PL_SHARED_DATA})
+add_dependencies(tests bag_detect_legs detect_people)

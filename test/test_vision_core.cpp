@@ -229,3 +229,31 @@ TEST(NonMaximumSuppression, KeepsBestOfOverlappingBoxes) {
   EXPECT_DOUBLE_EQ(kept[0].confidence, 0.9);
   EXPECT_EQ(kept[1].box.x, 300);
 }
+
+#include "picker_localisation/sensors_vision/cloud3d_person_detector.h"
+
+namespace {
+
+void addBox(pcl::PointCloud<pcl::PointXYZ>& cloud, Eigen::Vector3d lo, Eigen::Vector3d hi, double step) {
+  for (double x = lo.x(); x <= hi.x() + 1e-9; x += step)
+    for (double y = lo.y(); y <= hi.y() + 1e-9; y += step)
+      for (double z = lo.z(); z <= hi.z() + 1e-9; z += step) cloud.push_back(pcl::PointXYZ(x, y, z));
+}
+
+}  // namespace
+
+TEST(Cloud3dPersonDetector, PersonSizedClusterAboveGroundOnly) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  addBox(cloud, {-5, -5, 0}, {5, 5, 0}, 0.1);                 // level ground
+  addBox(cloud, {2.0, 1.0, 0.05}, {2.3, 1.4, 1.75}, 0.05);    // a person: 0.3 x 0.4 x 1.7 m
+  addBox(cloud, {-3.0, 2.0, 0.05}, {-2.5, 2.5, 0.5}, 0.05);   // a bush, too low
+  addBox(cloud, {0.0, -4.0, 0.05}, {4.0, -3.9, 2.0}, 0.05);   // a wall, too wide
+  cloud.push_back(pcl::PointXYZ(std::nanf(""), 0, 0));        // invalid points are skipped
+  const auto people = Cloud3dPersonDetector().detect(cloud);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_NEAR(people[0].centroid.x(), 2.15, 0.05);
+  EXPECT_NEAR(people[0].centroid.y(), 1.2, 0.05);
+  EXPECT_NEAR(people[0].extent.z(), 1.7, 0.1);
+  EXPECT_GT(people[0].confidence, 0.5);
+  EXPECT_TRUE(Cloud3dPersonDetector().detect(pcl::PointCloud<pcl::PointXYZ>()).empty());
+}

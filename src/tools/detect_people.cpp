@@ -1,5 +1,5 @@
 // Offline person boxes on a video or a folder of images:
-//   detect_people --video FILE | --images DIR --out FILE.csv [--resize F] [--onnx MODEL.onnx]
+//   detect_people --video FILE | --images DIR --out FILE.csv [--resize F] [--onnx MODEL.onnx] [--max-frames N]
 // CSV: frame,x,y,width,height,confidence (frame: the image's file name, or the video frame index; x, y: top-left
 // corner in pixels of the original image). HOG people detector unless --onnx is given.
 #include <opencv2/imgcodecs.hpp>
@@ -19,6 +19,7 @@ using namespace picker_localisation::sensors;
 
 int main(int argc, char** argv) {
   std::string video, images, out, onnx;
+  std::size_t max_frames = 0;  // 0: all
   HogOptions hog;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
@@ -27,13 +28,14 @@ int main(int argc, char** argv) {
     else if (a == "--out") out = argv[i + 1];
     else if (a == "--resize") hog.resize = std::stod(argv[i + 1]);
     else if (a == "--onnx") onnx = argv[i + 1];
+    else if (a == "--max-frames") max_frames = std::stoul(argv[i + 1]);
     else {
       std::fprintf(stderr, "detect_people: unknown option %s\n", a.c_str());
       return 2;
     }
   }
   if (out.empty() || video.empty() == images.empty()) {
-    std::fprintf(stderr, "usage: detect_people --video FILE|--images DIR --out FILE.csv [--resize F] [--onnx M]\n");
+    std::fprintf(stderr, "usage: detect_people --video FILE|--images DIR --out FILE.csv [--resize F] [--onnx M] [--max-frames N]\n");
     return 2;
   }
   try {
@@ -58,13 +60,15 @@ int main(int argc, char** argv) {
       cv::VideoCapture cap(video);
       if (!cap.isOpened()) throw std::runtime_error("cannot open video " + video);
       cv::Mat frame;
-      for (int index = 0; cap.read(frame); ++index) write(std::to_string(index), frame);
+      for (int index = 0; (max_frames == 0 || frames < max_frames) && cap.read(frame); ++index)
+        write(std::to_string(index), frame);
     } else {
       std::vector<std::filesystem::path> files;
       for (const auto& e : std::filesystem::directory_iterator(images))
         if (e.is_regular_file()) files.push_back(e.path());
       std::sort(files.begin(), files.end());
       for (const auto& f : files) {
+        if (max_frames > 0 && frames >= max_frames) break;
         const cv::Mat img = cv::imread(f.string(), cv::IMREAD_COLOR);
         if (img.empty()) continue;  // not an image
         write(f.filename().string(), img);
