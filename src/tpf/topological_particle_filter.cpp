@@ -125,6 +125,7 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
   graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion);
   edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
+  projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   node_scratch_a_.assign(map_->numNodes(), 0.0);
   node_scratch_b_.assign(map_->numNodes(), 0.0);
   reset();
@@ -163,13 +164,21 @@ std::vector<double> TopologicalParticleFilter::transitionProbabilities(NodeIndex
     for (auto& p : out) p = r / static_cast<double>(out.size());
     return out;
   }
-  double sum_b = 0.0;
-  for (std::uint32_t e = begin; e < end; ++e) sum_b += std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
-  if (!(sum_b > 0.0)) return out;
+  std::vector<double> b(out.size());
+  double sum_b = 0.0, max_b = 0.0;
   for (std::uint32_t e = begin; e < end; ++e) {
-    const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
-    out[e - begin] = b * edgeJumpProbability(lambda(b, g.arcs[e].length), dwell) / sum_b;
+    b[e - begin] = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
+    max_b = std::max(max_b, b[e - begin]);
   }
+  const double speed = std::sqrt(vx * vx + vy * vy);
+  if (max_b < params_.turn_projection_fraction * speed)  // turning (see predict())
+    for (std::uint32_t e = begin; e < end; ++e)
+      b[e - begin] = g.arcs[e].length > kMinEdgeLength ? speed : 0.0;
+  for (double x : b) sum_b += x;
+  if (!(sum_b > 0.0)) return out;
+  for (std::uint32_t e = begin; e < end; ++e)
+    out[e - begin] =
+        b[e - begin] * edgeJumpProbability(lambda(b[e - begin], g.arcs[e].length), dwell) / sum_b;
   return out;
 }
 
@@ -193,7 +202,8 @@ double TopologicalParticleFilter::particleWeight(const Particle& p, double norma
     // cos of the angle between the particle and the observed velocity; 0 (no preference) if either is zero.
     const double denom = speed * vs;
     const double cosang = denom > 1e-12 ? (p.vx * obs.velocity->x() + p.vy * obs.velocity->y()) / denom : 0.0;
-    w += gamma.velocity * 0.25 * (g + 0.5 * (cosang + 1.0));
+    const double wv = gamma.velocity * 0.25 * (g + 0.5 * (cosang + 1.0));
+    w = params_.velocity_weight_product ? w * (1.0 + wv) : w + wv;
   }
   return w;
 }
@@ -362,6 +372,8 @@ void TopologicalParticleFilter::predict(double dt) {
     return;
   }
   std::vector<double>& contrib = edge_scratch_;  // (sized to the largest degree at construction)
+  std::vector<double>& proj = projection_scratch_;
+  const double turn_fraction = params_.turn_projection_fraction;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
     const double tau0 = static_cast<double>(p.dwell), tau = tau0 + dt;
@@ -372,10 +384,22 @@ void TopologicalParticleFilter::predict(double dt) {
     // Per arc: b (Eq. 2), survival e1 = exp(lambda tau) at the dwell reached and e0 = exp(lambda tau0) at the
     // last step (1 in literal mode). Jump to k in this step with probability b_k (e0_k - e1_k) / sum b e0:
     // literal mode = Eq. 2 / 3 at tau; step-consistent mode = the same conditioned on no earlier jump.
+    // Turning: when no edge lies within acos(turn_fraction) of the velocity (lane end, corner into the
+    // headland), every edge gets b = |v| (see turn_projection_fraction).
+    double max_proj = 0.0;
+    for (std::uint32_t e = begin; e < end; ++e) {
+      const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
+      proj[e - begin] = b;
+      max_proj = std::max(max_proj, b);
+    }
+    if (max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
+      const double speed = std::sqrt(vx * vx + vy * vy);
+      for (std::uint32_t e = begin; e < end; ++e) proj[e - begin] = g.arcs[e].length > 0.0 ? speed : 0.0;
+    }
     double sum_b = 0.0, sum_c = 0.0, denom = 0.0;
     for (std::uint32_t e = begin; e < end; ++e) {
       const auto& arc = g.arcs[e];
-      const double b = std::max(0.0, vx * arc.ux + vy * arc.uy);
+      const double b = proj[e - begin];
       double c = 0.0, e0 = 1.0;
       if (b > 0.0) {
         // exp(lambda tau), lambda of Eq. 6; single precision is ample for a probability and twice as fast.
@@ -398,7 +422,7 @@ void TopologicalParticleFilter::predict(double dt) {
       while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
       // Pr(q') of Eq. 7: Eq. 2-3 probability of the transition taken at the dwell reached (rate independent).
       const auto& taken = g.arcs[e];
-      const double b_taken = std::max(0.0, vx * taken.ux + vy * taken.uy);
+      const double b_taken = proj[e - begin];
       const double pr = b_taken * (1.0 - std::exp(taken.rate * b_taken * tau)) / sum_b;
       const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
       const auto& arc = g.arcs[e];
@@ -497,15 +521,16 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     const float vs = std::sqrt(ox * ox + oy * oy);
     const float inv_sigma = 1.0f / static_cast<float>(std::max(0.5 * vs, params_.min_velocity_sigma));
     const float gv4 = static_cast<float>(0.25 * gamma.velocity);
+    const bool product = params_.velocity_weight_product;
     for (std::size_t i = 0; i < particles_.size(); ++i) {
       const Particle& p = particles_[i];
       const float speed = std::sqrt(p.vx * p.vx + p.vy * p.vy);
       const float z = (speed - vs) * inv_sigma;
       const float denom = speed * vs;
       const float cosang = denom > 1e-12f ? (p.vx * ox + p.vy * oy) / denom : 0.0f;
-      accumulate(i, p.node,
-                 gq * node_scratch_a_[p.node] + base +
-                     static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f))));
+      const double wq = gq * node_scratch_a_[p.node] + base;
+      const double wv = static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f)));
+      accumulate(i, p.node, product ? wq * (1.0 + wv) : wq + wv);
     }
   }
   const bool overlap = total > 0.0 && std::isfinite(total);

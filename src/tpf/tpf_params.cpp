@@ -41,6 +41,8 @@ std::string TpfParams::validate() const {
     return "dwell_noise_min must be <= dwell_noise_max";
   if (!finite_nonneg(fixed_lambda)) return "fixed_lambda must be >= 0";
   if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window)) return "velocity_window must be >= 1";
+  if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
+    return "turn_projection_fraction must be in [0, 1]";
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell)) return "min_jump_dwell must be > 0";
   if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma))
     return "min_velocity_sigma must be > 0";
@@ -132,6 +134,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "min_jump_dwell", p.min_jump_dwell);
   read(node, "directed_motion", p.directed_motion);
   read(node, "step_consistent_jumps", p.step_consistent_jumps);
+  read(node, "turn_projection_fraction", p.turn_projection_fraction);
   if (const YAML::Node g = node["sensor_gammas"]) {
     if (!g.IsMap()) throw std::runtime_error("tpf params: 'sensor_gammas' must be a map");
     for (const auto& kv : g) {
@@ -142,6 +145,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   if (const YAML::Node g = node["default_gamma"]) p.default_gamma = readGamma(g, "default_gamma");
   read(node, "gamma_as_confidence", p.gamma_as_confidence);
   read(node, "min_velocity_sigma", p.min_velocity_sigma);
+  read(node, "velocity_weight_product", p.velocity_weight_product);
   read(node, "accepted_sensors", p.accepted_sensors);
   read(node, "jsd_monitor", p.jsd_monitor);
   read(node, "jsd_threshold", p.jsd_threshold);

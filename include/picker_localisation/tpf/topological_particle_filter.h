@@ -18,14 +18,19 @@
 //  against
 //    the velocity (lambda = 0), contradicting the text ("null probability to those in the opposite
 //    direction"). We use the decomposition of Eq. 2 itself: P(jump to k) = b_k (1 - exp(lambda_k tau)) / sum
-//    b, so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen. Without any
-//    positive projection (sum b = 0) a particle stays.
+//    b, so the total jump probability is exactly Eq. 2 and nodes with b_k = 0 are never chosen.
+//  * Turning (Eq. 2 is 0/0 when no edge has a positive projection): when no edge lies within
+//    acos(turn_projection_fraction) (78 deg) of the velocity -- a lane end, a corner into the headland --
+//    every edge gets b_k = |v|, so the particle can turn and Eq. 7 rotates its velocity along the edge taken.
+//    With a forward edge present, edges against the velocity keep probability 0. turn_projection_fraction =
+//    0: such particles stay (they would wait for a re-initialisation, as nothing else changes their
+//    velocity).
 //  * tau in Eq. 2 is the dwell time at the prediction instant (tau_t + dt); at most one jump per prediction.
-//    With step_consistent_jumps (default) Eq. 2 is read as the probability of having left the node after
-//    dwelling tau, and a step from tau_t to tau_t + dt jumps with the conditional probability
-//    sum_k b_k (exp(l_k tau_t) - exp(l_k (tau_t + dt))) / sum_k b_k exp(l_k tau_t): one 3 s step and thirty
-//    0.1 s steps move the particles alike (the literal reading applies Eq. 2 afresh at every observation, so
-//    particles would run faster the more sensors report). A step with dt = 0 never jumps.
+//    With step_consistent_jumps (option; default off = literal) Eq. 2 is read as the probability of having
+//    left the node after dwelling tau, and a step from tau_t to tau_t + dt jumps with the conditional
+//    probability sum_k b_k (exp(l_k tau_t) - exp(l_k (tau_t + dt))) / sum_k b_k exp(l_k tau_t): one 3 s step
+//    and thirty 0.1 s steps move the particles alike (the literal reading applies Eq. 2 afresh at every
+//    observation, so particles would run faster the more sensors report). A step with dt = 0 never jumps.
 //  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector
 //  along
 //    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the Eq. 2-3 probability of the transition
@@ -188,8 +193,9 @@ class TopologicalParticleFilter {
   // |N|-sized scratch, all zero between calls (touched entries are cleared after use).
   std::vector<double> node_scratch_a_, node_scratch_b_;
   std::vector<topology::NodeIndex> touched_;
-  std::vector<double> edge_scratch_;       // per-edge jump contributions of one particle (max degree)
-  std::vector<std::uint32_t> spare_bits_;  // per particle: random bits of the prediction draw used by Eq. 12
+  std::vector<double> edge_scratch_;        // per-edge jump contributions of one particle (max degree)
+  std::vector<double> projection_scratch_;  // per-edge projections b of one particle (max degree)
+  std::vector<std::uint32_t> spare_bits_;   // per particle: random bits of the prediction draw used by Eq. 12
 
   double unconnected_p_ = 0.0;  // p_rj
   Belief belief_;

@@ -59,9 +59,13 @@ struct TpfParams {
   bool directed_motion = false;   // true: particles follow file edge direction; false: undirected graph
   // true: Eq. 2 is the probability of having left the node after dwelling tau, so a prediction step of dt
   // jumps with the conditional probability 1 - S(tau + dt) / S(tau), S = 1 - Eq. 2 (the motion no longer
-  // depends on how often observations arrive). false: Eq. 2 at tau is applied at every prediction (paper
-  // read literally; particles move faster the more sensors report).
-  bool step_consistent_jumps = true;
+  // depends on how often observations arrive). false (default, paper read literally): Eq. 2 at tau is applied
+  // at every prediction; particles move faster the more sensors report, which tracked better with 1 Hz GNSS
+  // in our lane-walk trials (docs/readme/tpf.md).
+  bool step_consistent_jumps = false;
+  // A particle whose velocity projects on no edge by at least this fraction of its speed (no edge within
+  // acos(0.2) = 78 deg: lane end, corner) treats every edge as aligned (b = |v|) so it can turn. 0: it stays.
+  double turn_projection_fraction = 0.2;
 
   // --- Eq. 8, weighting ------------------------------------------------------------------------------------
   // Keyed by Observation::sensor. Table I: gnss (1, 1), lidar (0.25, 0), rfid (1, 0). Choices for sensors
@@ -71,19 +75,22 @@ struct TpfParams {
   // false (paper): w_q = gamma_q * L^(q). true: w_q = gamma_q * L^(q) + (1 - gamma_q), i.e. gamma_q is the
   // confidence in the sensor and a low-confidence sensor only nudges the belief. L^ = L / max L.
   bool gamma_as_confidence = false;
+  // false (paper): w = w_q + w_v. true: w = w_q (1 + w_v), so velocity agreement scales the node term and a
+  // particle outside the node likelihood's support keeps weight 0 whatever its velocity.
+  bool velocity_weight_product = false;
   double min_velocity_sigma = 0.05;  // m/s, floor on sigma = |v^s| / 2 of the Gaussian of Eq. 8
   // Sensors this filter fuses; empty = all. Observations of other sensors are ignored (counted).
   std::vector<std::string> accepted_sensors;
 
   // --- Algorithm 1, monitors
   // ---------------------------------------------------------------------------------
-  bool jsd_monitor = true;         // re-initialise when JSD > jsd_threshold on an identifying observation
-  double jsd_threshold = 0.975;    // epsilon_JSD, [0, 1]
+  bool jsd_monitor = true;       // re-initialise when JSD > jsd_threshold on an identifying observation
+  double jsd_threshold = 0.975;  // epsilon_JSD, [0, 1]
   // Re-initialise only if, in addition, the mean of L / max L over the predicted particles is below this
   // (the observation contradicts the belief; a flat negative-information likelihood does not). 1: JSD alone.
   double reinit_max_mean_likelihood = 0.1;
-  bool entropy_gate = true;        // set p_rj to 0 once the entropy drops below entropy_threshold
-  double entropy_threshold = 0.6;  // epsilon_H, nats
+  bool entropy_gate = true;                    // set p_rj to 0 once the entropy drops below entropy_threshold
+  double entropy_threshold = 0.6;              // epsilon_H, nats
   double unconnected_jump_probability = 1e-3;  // p_rj at start and after each re-initialisation (Alg. 1 l. 8)
 
   // --- time ------------------------------------------------------------------------------------------------
