@@ -7,7 +7,10 @@
 #include <picker_localisation/PersonDetectionArray.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+
+#include <Eigen/Core>
 
 #include <cmath>
 #include <functional>
@@ -169,6 +172,52 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
         }
     }
   EXPECT_GE(camera_near, fused_scan.size() / 2) << "camera-confirmed people at the labelled legs";
+}
+
+// 3D LiDAR input: a synthetic cloud in the laser frame (ground at z = 0, a 0.3 x 0.4 x 1.7 m person at
+// (3, 1), a low bush) gives a "lidar3d" person at the person's position in the map frame once tracked.
+TEST(LegDetectorNode, PointCloudPerson) {
+  ros::NodeHandle nh;
+  Recorder rec;
+  auto people_sub = nh.subscribe("people", 100, &Recorder::onPeople, &rec);
+  auto pub = nh.advertise<sensor_msgs::PointCloud2>("points", 10);
+  ASSERT_TRUE(waitFor([&] { return pub.getNumSubscribers() > 0 && people_sub.getNumPublishers() > 0; }, 30.0));
+  std::vector<Eigen::Vector3f> pts;
+  auto box = [&](Eigen::Vector3f lo, Eigen::Vector3f hi, float step) {
+    for (float x = lo.x(); x <= hi.x() + 1e-6f; x += step)
+      for (float y = lo.y(); y <= hi.y() + 1e-6f; y += step)
+        for (float z = lo.z(); z <= hi.z() + 1e-6f; z += step) pts.emplace_back(x, y, z);
+  };
+  box({-1, -3, 0}, {6, 4, 0}, 0.1f);
+  box({3.0f, 1.0f, 0.05f}, {3.3f, 1.4f, 1.75f}, 0.05f);
+  box({1.0f, -2.0f, 0.05f}, {1.5f, -1.5f, 0.5f}, 0.05f);
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = "right_laser";
+  sensor_msgs::PointCloud2Modifier mod(cloud);
+  mod.setPointCloud2FieldsByString(1, "xyz");
+  mod.resize(pts.size());
+  sensor_msgs::PointCloud2Iterator<float> x(cloud, "x"), y(cloud, "y"), z(cloud, "z");
+  for (const auto& p : pts) {
+    *x = p.x();
+    *y = p.y();
+    *z = p.z();
+    ++x, ++y, ++z;
+  }
+  for (int k = 0; k < 5; ++k) {
+    cloud.header.stamp = ros::Time::now();
+    pub.publish(cloud);
+    waitFor([] { return false; }, 0.2);
+  }
+  ASSERT_TRUE(waitFor([&] { return rec.people.size() >= 5; }, 10.0));
+  bool found = false;
+  for (const auto& a : rec.people)
+    for (const auto& d : a.detections) {
+      if (d.sensor != "lidar3d") continue;
+      EXPECT_NEAR(d.position.x, 3.15 + kOffsetX, 0.1);
+      EXPECT_NEAR(d.position.y, 1.2 + kOffsetY, 0.1);
+      found = true;
+    }
+  EXPECT_TRUE(found);
 }
 
 int main(int argc, char** argv) {

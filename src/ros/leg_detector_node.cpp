@@ -154,11 +154,13 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
     ROS_WARN_THROTTLE(5.0, "%s: empty point cloud ignored", ros::this_node::getName().c_str());
     return;
   }
-  // The fixed frame's z is up: transform the cloud there before the ground removal.
-  const Eigen::Affine3f tff(tf.matrix().cast<float>());
-  for (auto& p : cloud.points) p.getVector3fMap() = tff * p.getVector3fMap();
+  // The fixed frame's z is up: rotate the cloud into its orientation (origin kept at the sensor, so the range
+  // gate stays relative to the sensor) before the ground removal, then translate the people.
+  const Eigen::Matrix3f rotation = tf.linear().cast<float>();
+  for (auto& p : cloud.points) p.getVector3fMap() = rotation * p.getVector3fMap();
   std::vector<PersonCandidate> people;
-  for (const auto& p : cloud_detector_.detect(cloud)) people.push_back({p.centroid.head<2>(), p.confidence, "lidar3d", true});
+  for (const auto& p : cloud_detector_.detect(cloud))
+    people.push_back({(p.centroid + tf.translation()).head<2>(), p.confidence, "lidar3d", true});
   publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
 }
 
