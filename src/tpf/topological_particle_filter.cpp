@@ -406,6 +406,9 @@ void TopologicalParticleFilter::predict(double dt) {
         const double e1 = std::exp(static_cast<float>(arc.rate * b * tau));
         if (consistent && tau0 > 0.0) e0 = std::exp(static_cast<float>(arc.rate * b * tau0));
         c = b * (e0 - e1);
+        proj[e - begin] = b * (1.0 - e1);  // b is no longer needed: keep Eq. 2-3's term for Eq. 7
+      } else {
+        proj[e - begin] = 0.0;
       }
       contrib[e - begin] = c;
       sum_b += b;
@@ -421,9 +424,7 @@ void TopologicalParticleFilter::predict(double dt) {
       double acc = contrib[0];
       while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
       // Pr(q') of Eq. 7: Eq. 2-3 probability of the transition taken at the dwell reached (rate independent).
-      const auto& taken = g.arcs[e];
-      const double b_taken = proj[e - begin];
-      const double pr = b_taken * (1.0 - std::exp(taken.rate * b_taken * tau)) / sum_b;
+      const double pr = proj[e - begin] / sum_b;
       const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
       const auto& arc = g.arcs[e];
       const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
