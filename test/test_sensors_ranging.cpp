@@ -394,6 +394,28 @@ TEST(RangeHistogramFilter, CameraBearingResolvesASingleRing) {
   EXPECT_NEAR(e->position.y(), 3.0, 0.15);
 }
 
+TEST(RangeHistogramFilter, CameraGateIgnoresBystandersAndUsesTheTarget) {
+  // Target at (4, 1.5) (UWB), a bystander at (-3, 2): the bystander's wedge meets only UWB floor cells
+  // (score 0.05 = P_min^uwb < gate 0.1) and is ignored; a wedge at the target passes. With the gate off both are used.
+  const Eigen::Vector2d target(4.0, 1.5), bystander(-3.0, 2.0);
+  const BearingMeasurement at_bystander{Eigen::Vector2d::Zero(), std::atan2(bystander.y(), bystander.x()), 0.03};
+  const BearingMeasurement at_target{Eigen::Vector2d::Zero(), std::atan2(target.y(), target.x()), 0.03};
+  RangeHistogramFilter gated;
+  auto e = gated.update(0.0, rangesTo(target), {at_bystander});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->bearings_used, 0u);
+  EXPECT_NEAR((e->position - target).norm(), 0.0, 0.1);
+  e = gated.update(0.1, rangesTo(target), {at_bystander, at_target});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->bearings_used, 1u);
+  RhfOptions o;
+  o.camera_gate = 0.0;
+  RangeHistogramFilter ungated(o);
+  e = ungated.update(0.0, rangesTo(target), {at_bystander, at_target});
+  ASSERT_TRUE(e.has_value());
+  EXPECT_EQ(e->bearings_used, 2u);
+}
+
 TEST(RangeHistogramFilter, InnovationDilatesByMaxSpeed) {
   // Move 1.2 m in 1 s: reachable with U = 1.5 m/s (estimate follows), not with U = 0.5 m/s (the innovation
   // floor P_min^inov = 0.01 < the observation floor 0.05 keeps the old place: hand-computed 0.01 vs 0.05).
@@ -548,6 +570,35 @@ TEST(UwbRanging, BatchesAnchorsIntoOneObservationAndRejectsBadInput) {
   EXPECT_EQ(c.out_of_range, 1u);
   EXPECT_EQ(c.out_of_order, 1u);
   EXPECT_EQ(c.updates, 2u);
+}
+
+TEST(UwbRanging, AmbiguousOrEdgeEstimatesAreNotPublished) {
+  auto map = latticeMap(10.0, 0.5);
+  UwbRanging uwb(twoPickers(), map);
+  std::vector<core::Observation> out;
+  // One anchor only: a ring of radius 4 (sd ~ 2.8 m > max_output_sigma 2 m) -> suppressed.
+  ASSERT_EQ(uwb.addRange(uwbInput(1.0, "uwb_1", 0, 4.0), Eigen::Isometry2d::Identity(), &out), UwbRejection::kNone);
+  uwb.flush(2.0, &out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(uwb.counters().suppressed, 1u);
+  EXPECT_EQ(uwb.counters().updates, 1u);
+  // Two anchors: the mirror pair (9.9, 0) / (-7.9, 0) of rings around (1, +-1) -> suppressed.
+  UwbRanging pair(twoPickers(), map);
+  for (int a = 0; a < 2; ++a)
+    pair.addRange(uwbInput(1.0, "uwb_1", a, (Eigen::Vector2d(9.9, 0.0) - kAnchors[a]).norm()),
+                  Eigen::Isometry2d::Identity(), &out);
+  pair.flush(2.0, &out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(pair.counters().suppressed, 1u);
+  // At the grid edge: a person 9.95 m ahead of a 20 m grid.
+  RangeHistogramFilter rhf;
+  auto e = rhf.update(0.0, rangesTo({9.95, 0.0}));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_TRUE(e->touches_border);
+  RangeHistogramFilter inside;
+  e = inside.update(0.0, rangesTo({8.0, 0.0}));
+  ASSERT_TRUE(e.has_value());
+  EXPECT_FALSE(e->touches_border);
 }
 
 TEST(UwbRanging, PdoaDirectAndAsBearing) {

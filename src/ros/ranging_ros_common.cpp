@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <sstream>
 
 #include "picker_localisation/ros/ranging_nodes.h"
 
@@ -58,6 +59,20 @@ std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, con
     ROS_FATAL("%s: %s", node, e.what());
     return std::nullopt;
   }
+}
+
+std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
+                                         const std::vector<std::string>& fallback) {
+  std::vector<std::string> list;
+  if (pnh.getParam(name, list)) return list;
+  std::string text;
+  if (!pnh.getParam(name, text)) return fallback;
+  // "[a, b]" or "a b" or "a,b" from the command line.
+  for (char& c : text)
+    if (c == '[' || c == ']' || c == ',' || c == '\'' || c == '"') c = ' ';
+  std::istringstream in(text);
+  for (std::string item; in >> item;) list.push_back(item);
+  return list;
 }
 
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {

@@ -36,8 +36,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   std::string topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
-  std::vector<std::string> topics{"rfid"};
-  pnh.param("rfid_topics", topics, topics);
+  const std::vector<std::string> topics = stringListParam(pnh, "rfid_topics", {"rfid"});
   for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
   updater_.setHardwareID("rfid_ranging");
   updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);

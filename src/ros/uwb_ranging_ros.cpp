@@ -26,6 +26,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("default_range_sigma", h.default_range_sigma, h.default_range_sigma);
   pnh.param("bearing_sigma", h.default_bearing_sigma, h.default_bearing_sigma);
   pnh.param("output_threshold", h.output_threshold, h.output_threshold);
+  pnh.param("camera_gate", h.camera_gate, h.camera_gate);
   pnh.param("max_range", o.max_range, o.max_range);
   pnh.param("batch_window", o.batch_window, o.batch_window);
   pnh.param("bearing_max_age", o.bearing_max_age, o.bearing_max_age);
@@ -34,6 +35,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("min_sigma", o.min_sigma, o.min_sigma);
   pnh.param("cutoff_sigmas", o.cutoff_sigmas, o.cutoff_sigmas);
   pnh.param("reset_after", o.reset_after, o.reset_after);
+  pnh.param("max_output_sigma", o.max_output_sigma, o.max_output_sigma);
   pnh.param<std::string>("map_frame", map_frame_, "map");
   pnh.param<std::string>("base_frame", base_frame_, "");
   pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
@@ -52,9 +54,8 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   std::string topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
-  std::vector<std::string> uwb_topics{"uwb"}, bearing_topics;
-  pnh.param("uwb_topics", uwb_topics, uwb_topics);
-  pnh.param("bearing_topics", bearing_topics, bearing_topics);
+  const std::vector<std::string> uwb_topics = stringListParam(pnh, "uwb_topics", {"uwb"});
+  const std::vector<std::string> bearing_topics = stringListParam(pnh, "bearing_topics", {});
   for (const std::string& t : uwb_topics) subs_.push_back(nh.subscribe(t, 200, &UwbRangingNode::onRange, this));
   for (const std::string& t : bearing_topics)
     subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
@@ -112,7 +113,10 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
   std::vector<core::Observation> out;
   std::string reason;
   const sensors::UwbRejection r = uwb_->addRange(in, planar(*robot), &out, &reason);
-  if (r != sensors::UwbRejection::kNone)
+  // A range beyond max_range is valid input outside the useful range (counted, logged at debug level only).
+  if (r == sensors::UwbRejection::kOutOfRange)
+    ROS_DEBUG_THROTTLE(5.0, "uwb_ranging: range ignored: %s", reason.c_str());
+  else if (r != sensors::UwbRejection::kNone)
     ROS_WARN_THROTTLE(5.0, "uwb_ranging: range rejected (%s): %s", sensors::toString(r), reason.c_str());
   publish(out);
 }
@@ -165,6 +169,7 @@ void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("rejected: beyond max_range", c.out_of_range);
   stat.add("rejected: out of order", c.out_of_order);
   stat.add("RHF updates", c.updates);
+  stat.add("suppressed (ambiguous / at grid edge)", c.suppressed);
   stat.add("camera detection sets", bearing_sets_);
   stat.add("published", published_);
   const std::size_t bad = tf_failures_ + c.unknown_tag + c.not_finite + c.negative_range + c.out_of_range + c.out_of_order;

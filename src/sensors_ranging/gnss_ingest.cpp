@@ -45,11 +45,12 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
     ++counter;
     return result;
   };
+  // NO_FIX first: receivers commonly send NaN positions with it, and "no fix" is the better reason.
+  if (fix.status < 0) return reject(GnssRejection::kNoFix, "status NO_FIX", counters_.no_fix);
   if (!std::isfinite(fix.stamp) || !std::isfinite(fix.latitude) || !std::isfinite(fix.longitude))
     return reject(GnssRejection::kNotFinite, "stamp, latitude or longitude is NaN/Inf", counters_.not_finite);
   if (std::abs(fix.latitude) > 90.0 || std::abs(fix.longitude) > 180.0)
     return reject(GnssRejection::kNotFinite, "latitude / longitude out of range", counters_.not_finite);
-  if (fix.status < 0) return reject(GnssRejection::kNoFix, "status NO_FIX", counters_.no_fix);
 
   // Horizontal covariance (ENU east-north block of the row-major 3x3).
   Eigen::Matrix2d c_en;

@@ -121,17 +121,18 @@ void clipHalfLine(double a, double c, double& lo, double& hi) {
 }
 }  // namespace
 
-// Camera grid (Eq. 6) into cam_ (touched cells); false when there is no usable bearing.
-bool RangeHistogramFilter::bearingGrid(const std::vector<BearingMeasurement>& bearings,
-                                       const Eigen::Isometry2d& pose) {
-  const float pmin = static_cast<float>(options_.p_min_cam);
+// Camera grid (Eq. 6) into cam_ (touched cells), for the bearings that pass the camera gate against the UWB
+// grid (normalised by inv_fmax). Returns the number of bearings used.
+std::size_t RangeHistogramFilter::bearingGrid(const std::vector<BearingMeasurement>& bearings,
+                                              const Eigen::Isometry2d& pose, float inv_fmax) {
   const double cut = std::max(options_.p_threshold, options_.p_min_cam);
+  const float thr = static_cast<float>(options_.p_threshold), pu = static_cast<float>(options_.p_min_uwb);
+  const float gate = static_cast<float>(options_.camera_gate);
   const double yaw = std::atan2(pose.linear()(1, 0), pose.linear()(0, 0));
   const double res = options_.resolution;
-  bool any = false;
+  std::size_t used = 0;
   for (const BearingMeasurement& bm : bearings) {
     if (!std::isfinite(bm.bearing) || !bm.origin.allFinite() || !std::isfinite(bm.sigma)) continue;
-    any = true;
     const double sigma = bm.sigma > 0.0 ? bm.sigma : options_.default_bearing_sigma;
     // Half opening of the wedge where exp(-0.5 (da / sigma)^2) > cut.
     const double lim = std::min(sigma * std::sqrt(2.0 * std::log(1.0 / cut)), 0.5 * M_PI - 1e-3);
@@ -141,6 +142,8 @@ bool RangeHistogramFilter::bearingGrid(const std::vector<BearingMeasurement>& be
     const double ux = std::cos(th), uy = std::sin(th);
     const float k = static_cast<float>(-0.5 / (sigma * sigma));
     const float fux = static_cast<float>(ux), fuy = static_cast<float>(uy), ft = static_cast<float>(t);
+    wedge_.clear();
+    float score = 0.0f;
     for (int iy = 0; iy < ny_; ++iy) {
       const double vy = min_y_ + (iy + 0.5) * res - o.y();
       // along > 0, t * along - lat > 0, t * along + lat > 0: three half-lines in vx.
@@ -160,15 +163,21 @@ bool RangeHistogramFilter::bearingGrid(const std::vector<BearingMeasurement>& be
         if (along <= 0.0f || std::abs(lat) >= along * ft) continue;
         const float diff = std::atan(lat / along);
         const float p = std::exp(k * diff * diff);
-        if (p > cut && p > cam_[row + ix]) {
-          touch(row + ix);
-          cam_[row + ix] = p;
-        }
+        if (!(p > cut)) continue;
+        wedge_.push_back({static_cast<std::uint32_t>(row + ix), p});
+        const float u = uwb_[row + ix] * inv_fmax;
+        score = std::max(score, p * ((u > thr && u > pu) ? u : pu));
       }
     }
+    if (gate > 0.0f && score < gate) continue;  // no target-like UWB cell on this wedge
+    ++used;
+    for (const auto& [i, p] : wedge_)
+      if (p > cam_[i]) {
+        touch(i);
+        cam_[i] = p;
+      }
   }
-  (void)pmin;
-  return any;
+  return used;
 }
 
 // tmp_ = M_{t-1} shifted by (sx, sy) cells (re-centring; cells from outside = 0), dilated along x by k cells.
@@ -304,8 +313,9 @@ std::optional<RhfEstimate> RangeHistogramFilter::update(double stamp, const std:
               po = static_cast<float>(options_.p_min_obs);
   auto eq3 = [thr](float v, float pmin) { return (v > thr && v > pmin) ? v : pmin; };
   const float fmax = rangeGrid(valid, robot_pose);
-  const bool has_cam = bearingGrid(bearings, robot_pose);
   const float inv_fmax = 1.0f / fmax;
+  const std::size_t bearings_used = bearingGrid(bearings, robot_pose, inv_fmax);
+  const bool has_cam = bearings_used > 0;
   auto uwb_at = [&](std::size_t i) { return eq3(uwb_[i] * inv_fmax, pu); };
   auto cam_at = [&](std::size_t i) { return has_cam ? cam_[i] : 1.0f; };
   const float raw0 = eq3(inv_fmax, pu) * (has_cam ? pc : 1.0f);
@@ -337,7 +347,9 @@ std::optional<RhfEstimate> RangeHistogramFilter::update(double stamp, const std:
   touched_.clear();
   initialised_ = true;
   last_stamp_ = stamp;
-  return normaliseAndEstimate();
+  RhfEstimate e = normaliseAndEstimate();
+  e.bearings_used = bearings_used;
+  return e;
 }
 
 // M_t /= max (Eq. 2 normalisation) and the estimate, in one pass after finding the max.
@@ -349,6 +361,7 @@ RhfEstimate RangeHistogramFilter::normaliseAndEstimate() {
   const float thr = static_cast<float>(options_.output_threshold);
   double w = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0;
   std::size_t count = 0;
+  bool border = false;
   for (int iy = 0; iy < ny_; ++iy) {
     float* row = &m_[static_cast<std::size_t>(iy) * nx_];
     const double y = (iy + 0.5) * res;  // relative to min (better conditioned sums)
@@ -356,6 +369,7 @@ RhfEstimate RangeHistogramFilter::normaliseAndEstimate() {
       const float v = row[ix] * inv;
       row[ix] = v;
       if (v <= thr) continue;
+      if (ix == 0 || iy == 0 || ix == nx_ - 1 || iy == ny_ - 1) border = true;
       const double x = (ix + 0.5) * res;
       w += v;
       sx += v * x;
@@ -368,6 +382,7 @@ RhfEstimate RangeHistogramFilter::normaliseAndEstimate() {
   }
   RhfEstimate e;
   e.support_cells = count;
+  e.touches_border = border;
   if (!(w > 0.0)) {  // only when output_threshold >= 1
     e.position = Eigen::Vector2d(min_x_ + 0.5 * nx_ * res, min_y_ + 0.5 * ny_ * res);
     e.covariance = Eigen::Matrix2d::Identity() * (options_.size_x * options_.size_x / 12.0);

@@ -1,5 +1,7 @@
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -156,6 +158,11 @@ void UwbRanging::processBatch(const std::string& tag, TagState& st, std::vector<
   std::optional<RhfEstimate> est = st.filter.update(b.last_stamp, b.ranges, bearings, b.robot_pose);
   if (!est) return;
   ++counters_.updates;
+  const double max_var = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(est->covariance).eigenvalues().maxCoeff();
+  if (est->touches_border || max_var > options_.max_output_sigma * options_.max_output_sigma) {
+    ++counters_.suppressed;
+    return;
+  }
   if (out) out->push_back(makeObservation(st.picker_id, b.robot_id, b.last_stamp, est->position, est->covariance));
   ++counters_.observations;
 }

@@ -36,6 +36,9 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
                                                  double timeout, std::string* error);
 // The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
 std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
+// A list-of-strings parameter; also accepts one string ("[a, b]", "a b") as rosrun _name:=... gives it.
+std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
+                                         const std::vector<std::string>& fallback);
 // Planar part of a 3D transform: x, y and the yaw of the x axis.
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 

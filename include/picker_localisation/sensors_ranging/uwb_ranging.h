@@ -58,7 +58,9 @@ const char* toString(UwbRejection r);
 struct UwbRangingOptions {
   std::string sensor = "uwb";
   RhfOptions rhf;
-  double max_range = 12.0;        // m, longer ranges are rejected (seed 004 Sec. 5.1: 12 m limit)
+  // m, longer ranges are rejected (seed 004 Sec. 5.1 uses 12 m). Keep it below the grid's half size minus the
+  // anchor offsets: a person beyond the grid edge cannot be represented (the default suits the 20 m grid).
+  double max_range = 9.5;
   double batch_window = 0.1;      // s, ranges of one tag within this window form one RHF update
   double bearing_max_age = 0.2;   // s, camera bearings older than this (vs the batch stamp) are not used
   // pdoa_mode: "ignore" (RHF on ranges only), "bearing" (a PDoA angle becomes a bearing in the RHF), or
@@ -68,11 +70,15 @@ struct UwbRangingOptions {
   double min_sigma = 0.3;         // m, floor of the node likelihood's sigma
   double cutoff_sigmas = 3.0;
   double reset_after = 5.0;       // s without ranges of a tag -> its filter restarts from the uniform prior
+  // An RHF estimate becomes an observation only when it is unimodal enough to be a Gaussian: its largest
+  // standard deviation <= max_output_sigma (one anchor's ring or two anchors' mirror pair are not) and no
+  // support cell lies on the grid edge. Suppressed estimates still update the filter (counted).
+  double max_output_sigma = 2.0;  // m
 };
 
 struct UwbCounters {
   std::size_t received = 0, accepted = 0, unknown_tag = 0, not_finite = 0, negative_range = 0, out_of_range = 0,
-              out_of_order = 0, updates = 0, observations = 0, bearings = 0;
+              out_of_order = 0, updates = 0, observations = 0, bearings = 0, suppressed = 0;
 };
 
 class UwbRanging {
