@@ -17,8 +17,8 @@
 //    |r - |c-a|| < b ln(1/p_threshold) is evaluated (outside it Eq. 3 gives P_min anyway): this is what makes
 //    an update cheap.
 //  * Camera grid (Eq. 6): per bearing p = exp(-0.5 (angle difference / sigma)^2) in front of the sensor, P_max
-//    = 1; several detections combine by max (any detected person may be the target); Eq. 3 with P_min^cam.
-//    No bearing: the camera grid is 1 everywhere.
+//    = 1; the detections that pass the camera gate (see RhfOptions::camera_gate) combine by max (any detected
+//    person may be the target); Eq. 3 with P_min^cam. No bearing passes: the camera grid is 1 everywhere.
 //  * Innovation (Eq. 7): M^I = dilate(M_{t-1}, U dt) with a square (Chebyshev) structuring element of half
 //    width ceil(U dt / resolution) cells (van Herk / Gil-Werman, O(1) per cell), then Eq. 3 with P_min^inov.
 //    It is computed at update time with the actual dt (the paper computes it one cycle ahead at a fixed
