@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBelief.h>
@@ -202,7 +203,20 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
   EXPECT_EQ(after.response.belief.observations, b1.observations + 1);
   EXPECT_LE(hops(after.response.belief.estimated_node, node_a), 1);
 
-  // 7. Reset: the belief is forgotten; the next observation initialises it again.
+  // 7. Diagnostics: picker_1's status with its counters, WARN after the rejected input above.
+  std::vector<diagnostic_msgs::DiagnosticStatus> statuses;
+  ros::Subscriber diag = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 50, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& st : m->status)
+          if (st.hardware_id == "picker_1") statuses.push_back(st);
+      });
+  ASSERT_TRUE(waitFor([&] { return !statuses.empty(); }, 5.0));
+  bool has_rejected = false;
+  for (const auto& kv : statuses.back().values)
+    if (kv.key == "rejected (invalid)") has_rejected = std::stoi(kv.value) >= 1;
+  EXPECT_TRUE(has_rejected);
+
+  // 8. Reset: the belief is forgotten; the next observation initialises it again.
   ros::ServiceClient reset = nh_.serviceClient<picker_localisation::ResetBelief>("/pickers/picker_1/reset");
   picker_localisation::ResetBelief r;
   ASSERT_TRUE(reset.call(r));

@@ -328,6 +328,13 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   const auto& c = filter_->counters();
   const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old;
   stat.add("picker_id", picker_id_);
+  // Input rate over the last diagnostics period (wall time: the rate at which this node is fed).
+  const ros::WallTime now = ros::WallTime::now();
+  if (!last_diag_time_.isZero() && now > last_diag_time_)
+    stat.add("observation rate (Hz)",
+             static_cast<double>(received_ - last_diag_received_) / (now - last_diag_time_).toSec());
+  last_diag_time_ = now;
+  last_diag_received_ = received_;
   stat.add("observations received", received_);
   stat.add("accepted", c.accepted);
   stat.add("reordered (late, within window)", c.reordered);

@@ -71,7 +71,8 @@ class TpfTracker {
   diagnostic_updater::Updater diagnostics_;
   double prediction_period_ = 0.0;
   std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0;
-  std::uint64_t last_reported_problems_ = 0;
+  std::uint64_t last_reported_problems_ = 0, last_diag_received_ = 0;
+  ros::WallTime last_diag_time_;
   std::string last_problem_;
 };
 
