@@ -1,14 +1,15 @@
-// rostest: the ROS node graph (farm_sim -> gnss_ingest / rfid_ranging / leg_detector -> tpf_tracker per picker ->
-// evaluator) against the offline runner (eval::runOnce, method rfid_lidar_gnss, scenario multi) on the same seed.
+// rostest: the ROS node graph (farm_sim -> gnss_ingest / rfid_ranging / leg_detector -> tpf_tracker per
+// picker -> evaluator) against the offline runner (eval::runOnce, method rfid_lidar_gnss, scenario multi) on
+// the same seed.
 //
 // Both simulate the same farm (same seed and config files: the pickers' walks and raw measurements are the
 // same), but they cannot agree sample by sample: in the graph, observations reach the trackers over topics in
 // arrival order with transport latency, periodic predictions fire on ROS timers, the evaluator samples the
-// latest belief on its own timer, and the trackers' particle filters draw from other seeds. So the test compares
-// the pooled mean errors over the run against the runner's mean over four tracker seeds, with tolerances
-// (kEuclideanTolerance, kTopologicalTolerance) a few times the spread between tracker seeds measured offline
-// (about 0.1 m and 0.4 nodes on 120 s) but far below what a wrong datum, frame or routing produces (metres,
-// several nodes).
+// latest belief on its own timer, and the trackers' particle filters draw from other seeds. So the test
+// compares the pooled mean errors over the run against the runner's mean over four tracker seeds, with
+// tolerances (kEuclideanTolerance, kTopologicalTolerance) a few times the spread between tracker seeds
+// measured offline (about 0.1 m and 0.4 nodes on 120 s) but far below what a wrong datum, frame or routing
+// produces (metres, several nodes).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
@@ -91,8 +92,10 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
     off_eu += m.euclidean_mean / 4.0;
     off_topo += m.topological_mean / 4.0;
   }
-  std::printf("graph: %zu samples, euclidean %.2f m, topological %.2f nodes; offline runner: euclidean %.2f m, "
-              "topological %.2f nodes\n", n, graph_eu, graph_topo, off_eu, off_topo);
+  std::printf(
+      "graph: %zu samples, euclidean %.2f m, topological %.2f nodes; offline runner: euclidean %.2f m, "
+      "topological %.2f nodes\n",
+      n, graph_eu, graph_topo, off_eu, off_topo);
   RecordProperty("graph_euclidean", std::to_string(graph_eu));
   RecordProperty("graph_topological", std::to_string(graph_topo));
   RecordProperty("offline_euclidean", std::to_string(off_eu));

@@ -1,5 +1,5 @@
-// Evaluation metrics against hand-computed values on the synthetic polytunnel (lane k at x = 1.5 k, lane nodes
-// r<k>_<j> at y = 3 j, headland H<k> at y = -3, T<k> at y = 30), aggregation and the Table II writers.
+// Evaluation metrics against hand-computed values on the synthetic polytunnel (lane k at x = 1.5 k, lane
+// nodes r<k>_<j> at y = 3 j, headland H<k> at y = -3, T<k> at y = 30), aggregation and the Table II writers.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -18,8 +18,12 @@ using namespace picker_localisation;
 using namespace picker_localisation::eval;
 
 namespace {
-topology::TopologicalMap polytunnel() { return topology::makePolytunnelMap(topology::PolytunnelSpec{}); }
-topology::NodeIndex idx(const topology::TopologicalMap& m, const std::string& n) { return *m.index(n); }
+topology::TopologicalMap polytunnel() {
+  return topology::makePolytunnelMap(topology::PolytunnelSpec{});
+}
+topology::NodeIndex idx(const topology::TopologicalMap& m, const std::string& n) {
+  return *m.index(n);
+}
 }  // namespace
 
 TEST(EvalMetrics, WrongLaneHandComputed) {
@@ -131,7 +135,8 @@ TEST(EvalReport, SummaryCsvHeaderAndUnavailableRow) {
   std::istringstream in(csv);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
+  EXPECT_EQ(line,
+            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
   std::getline(in, line);
   EXPECT_EQ(line, "khan_connected,10,1.5000,0.2500,3.0000,1.0000,0.8000");
   std::getline(in, line);
@@ -200,8 +205,8 @@ TEST(EvalReport, ErrorTableRows) {
   r >> id >> n >> eu >> eu_sd >> topo >> topo_sd >> share;
   EXPECT_EQ(id, "picker_1");
   EXPECT_EQ(n, 2u);
-  EXPECT_DOUBLE_EQ(eu, 1.5);     // errors 0 and 3
-  EXPECT_DOUBLE_EQ(topo, 0.5);   // hops 0 and 1
+  EXPECT_DOUBLE_EQ(eu, 1.5);    // errors 0 and 3
+  EXPECT_DOUBLE_EQ(topo, 0.5);  // hops 0 and 1
   EXPECT_DOUBLE_EQ(share, 1.0);
   EXPECT_EQ(all.rfind("all", 0), 0u);
 }

@@ -44,7 +44,8 @@ std::string writeSyntheticTmap2(const fs::path& dir) {
       << ", y: " << n.position.y() << ", z: 0.0}\n      orientation: {x: 0, y: 0, z: 0, w: 1}\n    edges:\n";
     for (const auto& e : map.edges())
       if (e.source == i)
-        y << "    - {edge_id: " << e.id << ", node: " << map.node(e.target).name << ", action: " << e.action << "}\n";
+        y << "    - {edge_id: " << e.id << ", node: " << map.node(e.target).name << ", action: " << e.action
+          << "}\n";
   }
   const fs::path path = dir / "synthetic_test.tmap2";
   std::ofstream(path) << y.str();
@@ -72,7 +73,8 @@ TEST(Experiment, MethodsAndScenarios) {
 }
 
 TEST(Experiment, SameSeedSameSummaryAnyJobs) {
-  if (!methodUnavailableReason("khan_connected").empty()) GTEST_SKIP() << methodUnavailableReason("khan_connected");
+  if (!methodUnavailableReason("khan_connected").empty())
+    GTEST_SKIP() << methodUnavailableReason("khan_connected");
   const fs::path dir = tempDir("determinism");
   ExperimentConfig c;
   c.map_path = writeSyntheticTmap2(dir);
@@ -90,7 +92,8 @@ TEST(Experiment, SameSeedSameSummaryAnyJobs) {
   runExperiment(c, log2);
   const std::string s1 = slurp(dir / "a" / "summary.csv");
   EXPECT_EQ(s1, slurp(dir / "b" / "summary.csv"));
-  EXPECT_EQ(slurp(dir / "a" / "khan_connected" / "run_1.csv"), slurp(dir / "b" / "khan_connected" / "run_1.csv"));
+  EXPECT_EQ(slurp(dir / "a" / "khan_connected" / "run_1.csv"),
+            slurp(dir / "b" / "khan_connected" / "run_1.csv"));
   EXPECT_EQ(s1.substr(0, s1.find('\n')),
             "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
   EXPECT_TRUE(fs::exists(dir / "a" / "summary.md"));
@@ -138,7 +141,8 @@ TEST(Experiment, UnavailableMethodIsReportedNotRun) {
 
 #ifdef PL_TEST_HAVE_SIM
 TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
-  if (!methodUnavailableReason("khan_connected").empty()) GTEST_SKIP() << methodUnavailableReason("khan_connected");
+  if (!methodUnavailableReason("khan_connected").empty())
+    GTEST_SKIP() << methodUnavailableReason("khan_connected");
   auto map = std::make_shared<const topology::TopologicalMap>(
       topology::loadMap(std::string(PL_SHARED_DATA) + "/topomaps/riseholme_sim.tmap"));
   RunConfig rc;
@@ -148,9 +152,9 @@ TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
   rc.duration = 30.0;
   const RunResult r = runOnce(map, rc);
   ASSERT_FALSE(r.samples.empty());
-  // The truth of a sample is the simulator's picker pose at that time (same seed; the pickers do not depend on
-  // the sensors switched on).
-  // the configuration the runner (and farm_sim in demo.launch) uses: config/sim.yaml + config/pickers.yaml
+  // The truth of a sample is the simulator's picker pose at that time (same seed; the pickers do not depend
+  // on the sensors switched on). the configuration the runner (and farm_sim in demo.launch) uses:
+  // config/sim.yaml + config/pickers.yaml
   const std::string sim_file = resolveConfigFile("", "sim.yaml");
   sim::SimConfig sc = sim_file.empty() ? sim::SimConfig() : sim::loadSimConfig(sim_file);
   sc.seed = 5;

@@ -55,7 +55,8 @@ TEST(UkfMetric, LidarRefinesIdentifiedTrackAndSpawnsAnonymousOnes) {
   UkfMetricTracker tracker;
   tracker.addGnss(0.0, "p1", Eigen::Vector2d(0, 0), Eigen::Matrix2d::Identity() * 4.0);
   // Leg detection 1 m away (inside the gate of a 2 m std fix) and one 30 m away (a new anonymous track).
-  const std::size_t associated = tracker.addDetections(0.1, {Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(30, 0)});
+  const std::size_t associated =
+      tracker.addDetections(0.1, {Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(30, 0)});
   EXPECT_EQ(associated, 1u);
   ASSERT_EQ(tracker.tracks().size(), 2u);
   EXPECT_EQ(tracker.tracks()[0].picker_id, "p1");

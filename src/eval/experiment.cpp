@@ -62,9 +62,12 @@ Scenario parseScenario(const std::string& name) {
 
 const char* toString(Scenario s) {
   switch (s) {
-    case Scenario::kSingle: return "single";
-    case Scenario::kNavigation: return "navigation";
-    case Scenario::kMulti: return "multi";
+    case Scenario::kSingle:
+      return "single";
+    case Scenario::kNavigation:
+      return "navigation";
+    case Scenario::kMulti:
+      return "multi";
   }
   return "?";
 }
@@ -110,7 +113,9 @@ std::string legModelPath(const RunConfig& config) {
                                   : config.leg_model;
 }
 
-std::size_t numPickers(Scenario s) { return s == Scenario::kMulti ? 3 : 1; }
+std::size_t numPickers(Scenario s) {
+  return s == Scenario::kMulti ? 3 : 1;
+}
 
 }  // namespace
 
@@ -139,8 +144,10 @@ std::vector<std::string> defaultMethods(Scenario s) {
   switch (s) {
     case Scenario::kSingle:
       return {"khan_unconnected", "khan_connected", "lidar_gnss", "rfid_gnss", "rfid_lidar_gnss"};
-    case Scenario::kNavigation: return {"estimated_node", "nbs"};
-    case Scenario::kMulti: return {"ukf_metric", "rfid_lidar_gnss", "no_monitor", "constant_speed"};
+    case Scenario::kNavigation:
+      return {"estimated_node", "nbs"};
+    case Scenario::kMulti:
+      return {"ukf_metric", "rfid_lidar_gnss", "no_monitor", "constant_speed"};
   }
   return {};
 }
@@ -164,7 +171,8 @@ std::string methodUnavailableReason(const std::string& method, const RunConfig& 
 #ifndef PL_HAVE_VISION
     missing.push_back("the LegDetector (library picker_localisation_vision)");
 #else
-    if (!fs::exists(legModelPath(config))) missing.push_back("the leg classifier model " + legModelPath(config));
+    if (!fs::exists(legModelPath(config)))
+      missing.push_back("the leg classifier model " + legModelPath(config));
 #endif
   }
   if (spec.policy != RobotPolicy::kPatrol) {
@@ -200,8 +208,8 @@ sensors::GnssFix toIngestFix(const sim::GnssFix& f) {
   return g;
 }
 
-// The front-end options the ROS nodes load from config/gnss_ingest.yaml and config/rfid_ranging.yaml (keys that
-// only concern the node, such as topics and timeouts, are skipped).
+// The front-end options the ROS nodes load from config/gnss_ingest.yaml and config/rfid_ranging.yaml (keys
+// that only concern the node, such as topics and timeouts, are skipped).
 template <typename T>
 void readKey(const YAML::Node& y, const char* key, T& value) {
   if (y[key]) value = y[key].as<T>();
@@ -316,8 +324,8 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag});
   }
   const core::PickerRegistry registry(registry_entries);
-  sensors::RfidObservationModel rfid_model(registry, map,
-                                          rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
+  sensors::RfidObservationModel rfid_model(
+      registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
   std::unique_ptr<sensors::LegDetector> legs;
   sensors::ClusterTracker leg_tracks;  // as the leg_detector node: one tracker over both lasers, map frame
@@ -338,8 +346,8 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
     prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
     for (std::size_t i = 0; i < n; ++i)
-      tracks[i].tpf = std::make_unique<tpf::TopologicalParticleFilter>(map, params,
-                                                                       sim::deriveSeed(config.tracker_seed ? config.tracker_seed : config.seed, 1000 + i));
+      tracks[i].tpf = std::make_unique<tpf::TopologicalParticleFilter>(
+          map, params, sim::deriveSeed(config.tracker_seed ? config.tracker_seed : config.seed, 1000 + i));
   }
 #endif
   auto toTracker = [&](const core::Observation& obs) {
@@ -455,7 +463,8 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     const double now = simulator.time();
 #ifdef PL_HAVE_TPF
     for (auto& t : tracks)  // periodic prediction when no observation arrives (Table I: 0.25 Hz)
-      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period) t.tpf->predictTo(now);
+      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period)
+        t.tpf->predictTo(now);
 #endif
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
     if (planner && (simulator.robot(0).atGoal() || now - last_plan >= config.replan_period)) {
@@ -487,15 +496,16 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
 }
 #else
 RunResult runOnce(std::shared_ptr<const topology::TopologicalMap>, const RunConfig& config) {
-  throw std::runtime_error("method " + config.method + " unavailable: " +
-                           methodUnavailableReason(config.method, config));
+  throw std::runtime_error("method " + config.method +
+                           " unavailable: " + methodUnavailableReason(config.method, config));
 }
 #endif
 
 ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log) {
   const auto wall0 = std::chrono::steady_clock::now();
   auto map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(config.map_path));
-  const std::vector<std::string> methods = config.methods.empty() ? defaultMethods(config.scenario) : config.methods;
+  const std::vector<std::string> methods =
+      config.methods.empty() ? defaultMethods(config.scenario) : config.methods;
   for (const auto& m : methods)
     if (!isKnownMethod(m)) throw std::invalid_argument("unknown method '" + m + "'");
   if (config.runs == 0) throw std::invalid_argument("--runs must be at least 1");
@@ -504,8 +514,8 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
 
   ExperimentResult res;
   log << "experiment: map " << map->name() << " (" << map->numNodes() << " nodes, " << map->numLanes()
-      << " lanes), scenario " << toString(config.scenario) << ", " << config.runs << " runs, seed " << config.seed
-      << ", " << config.duration << " s simulated, " << config.jobs << " job(s)\n";
+      << " lanes), scenario " << toString(config.scenario) << ", " << config.runs << " runs, seed "
+      << config.seed << ", " << config.duration << " s simulated, " << config.jobs << " job(s)\n";
   for (const auto& method : methods) {
     RunConfig rc = config.run;
     rc.scenario = config.scenario;
@@ -538,7 +548,8 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     worker();
     for (auto& th : pool) th.join();
     for (std::size_t k = 0; k < config.runs; ++k)
-      if (!errors[k].empty()) throw std::runtime_error("method " + method + " run " + std::to_string(k) + ": " + errors[k]);
+      if (!errors[k].empty())
+        throw std::runtime_error("method " + method + " run " + std::to_string(k) + ": " + errors[k]);
 
     fs::create_directories(fs::path(config.out_dir) / method);
     std::vector<std::vector<ErrorSample>> samples;
@@ -551,23 +562,24 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     res.rows.push_back(row);
     res.series.push_back(binErrors(method, samples, 0.0, std::max(5.0, config.duration / 100.0)));
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
-    log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean << " ("
-        << row.euclidean_std << ") m, topological " << row.topological_mean << " (" << row.topological_std
-        << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share << std::setprecision(1)
-        << "  [" << secs << " s wall]\n"
+    log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean
+        << " (" << row.euclidean_std << ") m, topological " << row.topological_mean << " ("
+        << row.topological_std << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share
+        << std::setprecision(1) << "  [" << secs << " s wall]\n"
         << std::defaultfloat;
   }
   writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
   std::ostringstream title;
-  title << "Table II, scenario " << toString(config.scenario) << ": map " << map->name() << ", " << config.runs
-        << " runs, seeds " << config.seed << ".." << config.seed + config.runs - 1 << ", " << config.duration
-        << " s simulated";
+  title << "Table II, scenario " << toString(config.scenario) << ": map " << map->name() << ", "
+        << config.runs << " runs, seeds " << config.seed << ".." << config.seed + config.runs - 1 << ", "
+        << config.duration << " s simulated";
   writeSummaryMarkdown((fs::path(config.out_dir) / "summary.md").string(), title.str(), res.rows);
   if (!res.series.empty()) plotErrors((fs::path(config.out_dir) / "errors.png").string(), res.series);
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   log << "experiment: wrote " << config.out_dir << "/summary.csv, summary.md"
       << (res.series.empty() ? "" : ", errors.png") << " in " << std::setprecision(1) << std::fixed
-      << res.wall_seconds << " s wall\n" << std::defaultfloat;
+      << res.wall_seconds << " s wall\n"
+      << std::defaultfloat;
   return res;
 }
 

@@ -42,9 +42,9 @@ void writeRunCsv(const std::string& path, const topology::TopologicalMap& map,
        "in_true_lane\n";
   for (const auto& s : samples) {
     f << num(s.stamp, 3) << ',' << s.picker_id << ',' << map.node(s.estimated_node).name << ','
-      << map.node(s.true_node).name << ',' << num(s.true_position.x(), 3) << ',' << num(s.true_position.y(), 3)
-      << ',' << num(s.euclidean, 4) << ',' << s.topological << ',' << int(s.lane_applicable) << ','
-      << int(s.in_true_lane) << '\n';
+      << map.node(s.true_node).name << ',' << num(s.true_position.x(), 3) << ','
+      << num(s.true_position.y(), 3) << ',' << num(s.euclidean, 4) << ',' << s.topological << ','
+      << int(s.lane_applicable) << ',' << int(s.in_true_lane) << '\n';
   }
   if (!f) throw std::runtime_error("error writing '" + path + "'");
 }
@@ -80,10 +80,10 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
       f << "| " << r.method << " | - | unavailable: " << r.unavailable_reason << " | | | | |\n";
       continue;
     }
-    f << "| " << r.method << " | " << r.runs << " | " << num(r.euclidean_mean, 2) << " (" << num(r.euclidean_std, 2)
-      << ") | " << num(r.euclidean_pooled_std, 2) << " | " << num(r.topological_mean, 2) << " ("
-      << num(r.topological_std, 2) << ") | " << num(r.topological_pooled_std, 2) << " | "
-      << num(r.right_lane_share, 3) << " |\n";
+    f << "| " << r.method << " | " << r.runs << " | " << num(r.euclidean_mean, 2) << " ("
+      << num(r.euclidean_std, 2) << ") | " << num(r.euclidean_pooled_std, 2) << " | "
+      << num(r.topological_mean, 2) << " (" << num(r.topological_std, 2) << ") | "
+      << num(r.topological_pooled_std, 2) << " | " << num(r.right_lane_share, 3) << " |\n";
   }
   return f.str();
 }
@@ -105,8 +105,8 @@ std::string errorTable(const std::vector<std::pair<std::string, std::vector<Erro
       << num(r.right_lane_share, 3) << '\n';
   };
   f << std::left << std::setw(14) << "picker" << std::right << std::setw(8) << "samples" << std::setw(10)
-    << "eucl[m]" << std::setw(9) << "std" << std::setw(10) << "topo[n]" << std::setw(9) << "std" << std::setw(11)
-    << "right_lane" << '\n';
+    << "eucl[m]" << std::setw(9) << "std" << std::setw(10) << "topo[n]" << std::setw(9) << "std"
+    << std::setw(11) << "right_lane" << '\n';
   std::vector<ErrorSample> all;
   for (const auto& [id, samples] : per_picker) {
     row(id, samples);
@@ -154,7 +154,7 @@ ErrorSeries binErrors(const std::string& method, const std::vector<std::vector<E
 namespace {
 
 cv::Scalar colourOf(std::size_t i) {
-  static const cv::Scalar palette[] = {{180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},
+  static const cv::Scalar palette[] = {{180, 119, 31},  {14, 127, 255}, {44, 160, 44},   {40, 39, 214},
                                        {189, 103, 148}, {75, 86, 140},  {194, 119, 227}, {127, 127, 127},
                                        {34, 189, 188},  {207, 190, 23}};
   return palette[i % (sizeof(palette) / sizeof(palette[0]))];
@@ -181,16 +181,19 @@ void drawPanel(cv::Mat& img, const cv::Rect& area, const std::vector<ErrorSeries
     cv::line(img, p, cv::Point(area.x + area.width, p.y), cv::Scalar(225, 225, 225), 1);
     std::ostringstream l;
     l << std::fixed << std::setprecision(1) << y;
-    cv::putText(img, l.str(), cv::Point(area.x - 45, p.y + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0));
+    cv::putText(img, l.str(), cv::Point(area.x - 45, p.y + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar(0, 0, 0));
   }
   for (int k = 0; k <= 5; ++k) {  // t ticks
     const double t = t_max * k / 5.0;
     const cv::Point p = px(t, 0.0);
     std::ostringstream l;
     l << std::fixed << std::setprecision(0) << t;
-    cv::putText(img, l.str(), cv::Point(p.x - 10, p.y + 16), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0));
+    cv::putText(img, l.str(), cv::Point(p.x - 10, p.y + 16), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar(0, 0, 0));
   }
-  cv::putText(img, ylabel, cv::Point(area.x + 5, area.y - 6), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0));
+  cv::putText(img, ylabel, cv::Point(area.x + 5, area.y - 6), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+              cv::Scalar(0, 0, 0));
   for (std::size_t k = 0; k < series.size(); ++k) {
     const auto& s = series[k];
     for (std::size_t i = 1; i < s.t.size(); ++i) {

@@ -40,16 +40,21 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     p.id = registry.pickers()[i].id;
     const std::string base = "/pickers/" + p.id;
     p.belief_sub = nh.subscribe<picker_localisation::PickerBelief>(
-        base + "/belief", 10, [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(i, m); });
+        base + "/belief", 10,
+        [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(i, m); });
     p.truth_sub = nh.subscribe<geometry_msgs::PoseStamped>(
-        base + "/ground_truth", 10, [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) { onTruth(i, m); });
+        base + "/ground_truth", 10,
+        [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) { onTruth(i, m); });
     p.error_pub = nh.advertise<picker_localisation::TrackingError>(base + "/error", 10);
   }
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
   timer_ = nh.createTimer(ros::Duration(1.0 / sample_rate), &Evaluator::onTimer, this);
   ROS_INFO("evaluator: %zu pickers, map '%s', sampling at %g Hz%s", pickers_.size(), map_->name().c_str(),
-           sample_rate, duration_ > 0.0 ? (", stopping " + std::to_string(duration_) + " s after the first ground truth").c_str() : "");
+           sample_rate,
+           duration_ > 0.0
+               ? (", stopping " + std::to_string(duration_) + " s after the first ground truth").c_str()
+               : "");
   ok_ = true;
 }
 
@@ -76,7 +81,8 @@ void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPt
     return;
   }
   p.truth = t;
-  if (first_truth_ < 0.0) first_truth_ = msg->header.stamp.isZero() ? ros::Time::now().toSec() : msg->header.stamp.toSec();
+  if (first_truth_ < 0.0)
+    first_truth_ = msg->header.stamp.isZero() ? ros::Time::now().toSec() : msg->header.stamp.toSec();
 }
 
 void Evaluator::onTimer(const ros::TimerEvent& ev) {
@@ -84,7 +90,8 @@ void Evaluator::onTimer(const ros::TimerEvent& ev) {
   const ros::Time now = ev.current_expected;
   for (Picker& p : pickers_) {
     if (!p.estimated_node || !p.truth) continue;
-    const eval::ErrorSample s = eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, now.toSec(), p.id);
+    const eval::ErrorSample s =
+        eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, now.toSec(), p.id);
     p.samples.push_back(s);
     picker_localisation::TrackingError msg;
     msg.header.stamp = now;
@@ -140,7 +147,8 @@ void Evaluator::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   if (rejected > 0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "rejected beliefs / ground truths (see counts)");
   else if (waiting > 0)
-    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, std::to_string(waiting) + " picker(s) without belief or truth");
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN,
+                 std::to_string(waiting) + " picker(s) without belief or truth");
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "evaluating");
 }

@@ -1,7 +1,9 @@
 // experiment: the offline Table II runner (in-process, deterministic, no roscore).
 //   experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N] [--seed S]
-//              [--duration SEC] --out DIR [--jobs J] [--sample-period SEC] [--leg-model FILE] [--tpf-config FILE]
-//              [--sim-config FILE] [--datum FILE] [--pickers FILE] [--tracker-seed N]
+//              [--duration SEC] --out DIR [--jobs J] [--sample-period SEC] [--leg-model FILE] [--tpf-config
+//              FILE]
+//              [--sim-config FILE] [--datum FILE] [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE]
+//              [--tracker-seed N]
 // Exit status: 0 success, 2 bad arguments / map / output directory.
 #include <cstdlib>
 #include <iostream>
@@ -17,8 +19,9 @@ void usage(std::ostream& o) {
   o << "usage: experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N]\n"
        "                  [--seed S] [--duration SEC] --out DIR [--jobs J] [--sample-period SEC]\n"
        "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
-       "                  [--pickers FILE] [--tracker-seed N]\n"
-       "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in defaults\n"
+       "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--tracker-seed N]\n"
+       "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in "
+       "defaults\n"
        "methods:";
   for (const auto& m : picker_localisation::eval::allMethodNames()) o << ' ' << m;
   o << "\ndefaults: methods = the scenario's Table II rows, runs 10, seed 1, duration 600 s, jobs 1\n";
@@ -48,22 +51,42 @@ int main(int argc, char** argv) {
       }
       if (i + 1 >= argc) throw std::invalid_argument("missing value after " + a);
       const std::string v = argv[++i];
-      if (a == "--map") cfg.map_path = v;
-      else if (a == "--scenario") scenario = v;
-      else if (a == "--methods") cfg.methods = splitComma(v);
-      else if (a == "--runs") cfg.runs = std::stoul(v);
-      else if (a == "--seed") cfg.seed = std::stoull(v);
-      else if (a == "--duration") cfg.duration = std::stod(v);
-      else if (a == "--out") cfg.out_dir = v;
-      else if (a == "--jobs") cfg.jobs = std::stoul(v);
-      else if (a == "--sample-period") cfg.run.sample_period = std::stod(v);
-      else if (a == "--leg-model") cfg.run.leg_model = v;
-      else if (a == "--tpf-config") cfg.run.tpf_config = v;
-      else if (a == "--sim-config") cfg.run.sim_config = v;
-      else if (a == "--datum") cfg.run.datum_file = v;
-      else if (a == "--pickers") cfg.run.pickers_file = v;
-      else if (a == "--tracker-seed") cfg.run.tracker_seed = std::stoull(v);
-      else throw std::invalid_argument("unknown option " + a);
+      if (a == "--map")
+        cfg.map_path = v;
+      else if (a == "--scenario")
+        scenario = v;
+      else if (a == "--methods")
+        cfg.methods = splitComma(v);
+      else if (a == "--runs")
+        cfg.runs = std::stoul(v);
+      else if (a == "--seed")
+        cfg.seed = std::stoull(v);
+      else if (a == "--duration")
+        cfg.duration = std::stod(v);
+      else if (a == "--out")
+        cfg.out_dir = v;
+      else if (a == "--jobs")
+        cfg.jobs = std::stoul(v);
+      else if (a == "--sample-period")
+        cfg.run.sample_period = std::stod(v);
+      else if (a == "--leg-model")
+        cfg.run.leg_model = v;
+      else if (a == "--tpf-config")
+        cfg.run.tpf_config = v;
+      else if (a == "--sim-config")
+        cfg.run.sim_config = v;
+      else if (a == "--datum")
+        cfg.run.datum_file = v;
+      else if (a == "--pickers")
+        cfg.run.pickers_file = v;
+      else if (a == "--gnss-config")
+        cfg.run.gnss_config = v;
+      else if (a == "--rfid-config")
+        cfg.run.rfid_config = v;
+      else if (a == "--tracker-seed")
+        cfg.run.tracker_seed = std::stoull(v);
+      else
+        throw std::invalid_argument("unknown option " + a);
     }
     if (cfg.map_path.empty() || scenario.empty() || cfg.out_dir.empty())
       throw std::invalid_argument("--map, --scenario and --out are required");

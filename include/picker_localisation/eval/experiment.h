@@ -1,7 +1,8 @@
 // The offline Table II experiment runner (Navigate-and-Seek Sec. VI): in-process, deterministic, no roscore.
 // Per run: farm simulator raw measurements -> the real front-end core classes (GnssIngest for fixes,
-// LegDetector on the simulated scans, RfidObservationModel on reads) -> Observations -> one tracker per picker
-// (TopologicalParticleFilter with the method's parameter preset, or the ukf_metric baseline) -> metrics.
+// LegDetector on the simulated scans, RfidObservationModel on reads) -> Observations -> one tracker per
+// picker (TopologicalParticleFilter with the method's parameter preset, or the ukf_metric baseline) ->
+// metrics.
 //
 // Scenarios fix the pickers and the default method list:
 //   single      1 picker, 1 robot  (Table II "Single picker")
@@ -9,8 +10,8 @@
 //   multi       3 pickers, 1 robot (Table II "Multiple pickers")
 // The robot patrols the lanes (simulator patrol `lanes`) unless the method is a navigation policy
 // (estimated_node, nbs), whose planner then sets the robot's goals.
-// A method whose components are not in this build (or whose data file is missing) is reported unavailable with
-// the reason; it is never run with a substitute.
+// A method whose components are not in this build (or whose data file is missing) is reported unavailable
+// with the reason; it is never run with a substitute.
 #pragma once
 
 #include <cstdint>
@@ -39,14 +40,14 @@ bool isKnownMethod(const std::string& method);
 struct RunConfig {
   Scenario scenario = Scenario::kSingle;
   std::string method = "rfid_lidar_gnss";
-  std::uint64_t seed = 1;          // simulator seed of this run; trackers derive theirs from it
-  double duration = 600.0;         // simulated s (one tour of the Riseholme lanes at 0.5 m/s)
-  double sample_period = 1.0;      // s between metric samples (per picker)
-  double step = 0.1;               // s, simulator advance between event merges
-  double lidar_sigma = 0.3;        // m, std of the Gaussian node likelihood of a leg detection (leg_detector
-                                   // node ~position_sigma)
-  bool require_confirmed = true;   // leg_detector node ~require_confirmed: only confirmed cluster tracks
-  double replan_period = 10.0;     // s, navigation policies re-plan at least this often
+  std::uint64_t seed = 1;         // simulator seed of this run; trackers derive theirs from it
+  double duration = 600.0;        // simulated s (one tour of the Riseholme lanes at 0.5 m/s)
+  double sample_period = 1.0;     // s between metric samples (per picker)
+  double step = 0.1;              // s, simulator advance between event merges
+  double lidar_sigma = 0.3;       // m, std of the Gaussian node likelihood of a leg detection (leg_detector
+                                  // node ~position_sigma)
+  bool require_confirmed = true;  // leg_detector node ~require_confirmed: only confirmed cluster tracks
+  double replan_period = 10.0;    // s, navigation policies re-plan at least this often
   // Configuration files shared with the ROS graph (farm_sim, gnss_ingest, tpf_tracker, ...), so the runner
   // and demo.launch simulate the same farm. "" = the package's config/<file> when it exists, else built-in
   // defaults; "none" = built-in defaults.
@@ -68,7 +69,7 @@ std::string methodUnavailableReason(const std::string& method, const RunConfig& 
 
 struct RunResult {
   std::vector<ErrorSample> samples;
-  std::size_t observations = 0;    // observations given to trackers
+  std::size_t observations = 0;  // observations given to trackers
   std::size_t lidar_detections = 0;
   double wall_seconds = 0.0;
 };
@@ -81,11 +82,11 @@ struct ExperimentConfig {
   Scenario scenario = Scenario::kSingle;
   std::vector<std::string> methods;  // empty: defaultMethods(scenario)
   std::size_t runs = 10;
-  std::uint64_t seed = 1;            // run k (0-based) uses seed + k, the same for every method
+  std::uint64_t seed = 1;  // run k (0-based) uses seed + k, the same for every method
   double duration = 600.0;
   std::string out_dir;
-  std::size_t jobs = 1;              // runs executed in parallel (results do not depend on it)
-  RunConfig run;                     // template for the per-run options (scenario/method/seed/duration set here)
+  std::size_t jobs = 1;  // runs executed in parallel (results do not depend on it)
+  RunConfig run;         // template for the per-run options (scenario/method/seed/duration set here)
 };
 
 struct ExperimentResult {
@@ -95,8 +96,8 @@ struct ExperimentResult {
 };
 
 // Runs every method `runs` times and writes DIR/<method>/run_<k>.csv, DIR/summary.csv, DIR/summary.md and
-// DIR/errors.png. Progress and unavailable methods are reported on `log`. Throws std::runtime_error on a bad map
-// or an unwritable directory.
+// DIR/errors.png. Progress and unavailable methods are reported on `log`. Throws std::runtime_error on a bad
+// map or an unwritable directory.
 ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log);
 
 }  // namespace eval

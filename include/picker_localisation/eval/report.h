@@ -28,8 +28,8 @@ void writeSummaryMarkdown(const std::string& path, const std::string& title,
                           const std::vector<MethodSummary>& rows);
 std::string summaryMarkdown(const std::string& title, const std::vector<MethodSummary>& rows);
 
-// Plain-text table of the errors per picker plus an `all` row (pickers pooled): samples, Euclidean mean/std [m],
-// topological mean/std [nodes], right-lane share. Printed by the evaluator node at shutdown.
+// Plain-text table of the errors per picker plus an `all` row (pickers pooled): samples, Euclidean mean/std
+// [m], topological mean/std [nodes], right-lane share. Printed by the evaluator node at shutdown.
 std::string errorTable(const std::vector<std::pair<std::string, std::vector<ErrorSample>>>& per_picker);
 
 // Mean error over time of one method (all runs and pickers, binned).
@@ -44,8 +44,8 @@ struct ErrorSeries {
 ErrorSeries binErrors(const std::string& method, const std::vector<std::vector<ErrorSample>>& runs, double t0,
                       double bin_width);
 
-// Two panels (Euclidean error [m] above, topological error [hops] below) with one coloured line per method and
-// a legend. Throws std::runtime_error when the image cannot be written.
+// Two panels (Euclidean error [m] above, topological error [hops] below) with one coloured line per method
+// and a legend. Throws std::runtime_error when the image cannot be written.
 void plotErrors(const std::string& path, const std::vector<ErrorSeries>& series, int width = 1000,
                 int height = 700);
 

@@ -1,15 +1,15 @@
 // `ukf_metric` baseline of Table II ("Dondrup et al. [23]"): a metric multi-person tracker in the spirit of
 // bayes_people_tracker, written here with Eigen. Each track is an Unscented Kalman Filter over
 // x = [px, py, vx, vy] with a constant-velocity model (white-acceleration noise); LiDAR leg detections are
-// anonymous position measurements associated by global nearest neighbour inside a Mahalanobis gate; GNSS fixes
-// are identified position updates. The per-picker estimate is mapped to the nearest node by the caller.
+// anonymous position measurements associated by global nearest neighbour inside a Mahalanobis gate; GNSS
+// fixes are identified position updates. The per-picker estimate is mapped to the nearest node by the caller.
 //
 // Picker <-> track association follows Navigate-and-Seek Sec. VI-C: a picker's fix updates the track already
-// labelled with that picker; when the picker has no track (first fix, or its track was lost), the fix adopts the
-// nearest unlabelled track inside the gate, else starts a new labelled track. Unassociated LiDAR detections start
-// anonymous tracks (as bayes_people_tracker does); a track whose position variance exceeds
-// `max_position_variance` is deleted. When a picker has no track, estimate() returns the last estimate it had.
-// ROS-free, deterministic (no random draws).
+// labelled with that picker; when the picker has no track (first fix, or its track was lost), the fix adopts
+// the nearest unlabelled track inside the gate, else starts a new labelled track. Unassociated LiDAR
+// detections start anonymous tracks (as bayes_people_tracker does); a track whose position variance exceeds
+// `max_position_variance` is deleted. When a picker has no track, estimate() returns the last estimate it
+// had. ROS-free, deterministic (no random draws).
 #pragma once
 
 #include <Eigen/Core>
@@ -24,12 +24,12 @@ namespace picker_localisation {
 namespace eval {
 
 struct UkfTrackerParams {
-  double acceleration_noise = 0.5;     // white-acceleration spectral density of the CV model, m^2/s^3
-  double lidar_sigma = 0.15;           // std of a leg detection's position, m
-  double init_velocity_sigma = 1.0;    // std of the velocity of a new track, m/s
-  double gate_chi2 = 9.21;             // Mahalanobis gate (chi^2, 2 dof, 99 %)
-  double max_position_variance = 16.0; // a track is deleted when (P_xx + P_yy) / 2 exceeds this, m^2
-  double max_speed = 2.5;              // velocity is clipped to this after each update, m/s
+  double acceleration_noise = 0.5;      // white-acceleration spectral density of the CV model, m^2/s^3
+  double lidar_sigma = 0.15;            // std of a leg detection's position, m
+  double init_velocity_sigma = 1.0;     // std of the velocity of a new track, m/s
+  double gate_chi2 = 9.21;              // Mahalanobis gate (chi^2, 2 dof, 99 %)
+  double max_position_variance = 16.0;  // a track is deleted when (P_xx + P_yy) / 2 exceeds this, m^2
+  double max_speed = 2.5;               // velocity is clipped to this after each update, m/s
   // Unscented transform (Julier/Wan-van der Merwe): alpha, beta, kappa.
   double alpha = 1.0, beta = 2.0, kappa = 0.0;
 };
@@ -39,7 +39,7 @@ struct MetricTrack {
   std::string picker_id;  // "" while anonymous
   Eigen::Vector4d x = Eigen::Vector4d::Zero();
   Eigen::Matrix4d P = Eigen::Matrix4d::Identity();
-  double stamp = 0.0;      // time the state refers to, s
+  double stamp = 0.0;  // time the state refers to, s
   std::size_t updates = 0;
 };
 

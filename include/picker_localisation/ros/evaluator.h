@@ -1,10 +1,13 @@
 // evaluator node: compares each picker's belief with its simulated ground truth (Navigate-and-Seek Sec. VI
 // metrics, eval::computeError), publishes the live error and prints the error table at shutdown.
 //   subscribes  /pickers/<id>/belief (picker_localisation/PickerBelief), /pickers/<id>/ground_truth
-//               (geometry_msgs/PoseStamped) for every picker of ~pickers_file; the map as ros_adapter::obtainMap
+//               (geometry_msgs/PoseStamped) for every picker of ~pickers_file; the map as
+//               ros_adapter::obtainMap
 //   publishes   /pickers/<id>/error (picker_localisation/TrackingError), /diagnostics
-//   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; s of ROS time after
-//               the first ground truth, then the table is printed and the node exits: end it with required="true"), ~output_csv ("" none: per-sample CSV at exit)
+//   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; s of ROS time
+//   after
+//               the first ground truth, then the table is printed and the node exits: end it with
+//               required="true"), ~output_csv ("" none: per-sample CSV at exit)
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
