@@ -98,3 +98,43 @@ TEST(PickerRegistry, BadFiles) {
     EXPECT_NE(std::string(e.what()).find("p.yaml: duplicate picker id 'a'"), std::string::npos) << e.what();
   }
 }
+
+#include "picker_localisation/core/stamp_ordered_buffer.h"
+
+TEST(StampOrderedBuffer, ReleasesInStampOrderAfterLatencyWhateverTheArrivalOrder) {
+  // Two arrival orders of the same messages release the same sequence.
+  const std::vector<std::tuple<double, std::string, int>> msgs{
+      {1.0, "gnss", 1}, {0.9, "lidar", 2}, {1.0, "camera", 3}, {2.5, "gnss", 4}, {1.2, "rfid", 5}};
+  auto run = [&](std::vector<std::size_t> order) {
+    StampOrderedBuffer<int> b(0.5);
+    std::vector<int> seen;
+    double now = 0.0;
+    for (std::size_t k : order) {
+      b.push(std::get<0>(msgs[k]), std::get<1>(msgs[k]), std::get<2>(msgs[k]));
+      now += 0.3;
+      for (auto& [stamp, v] : b.release(now)) {
+        EXPECT_LE(stamp, now - 0.5);
+        seen.push_back(v);
+      }
+    }
+    for (auto& [stamp, v] : b.releaseAll()) seen.push_back(v);
+    return seen;
+  };
+  const std::vector<int> want{2, 3, 1, 5, 4};  // by stamp, ties by key ("camera" < "gnss")
+  EXPECT_EQ(run({0, 1, 2, 3, 4}), want);
+  EXPECT_EQ(run({4, 3, 2, 1, 0}), want);
+  EXPECT_EQ(run({2, 0, 4, 1, 3}), want);
+}
+
+TEST(StampOrderedBuffer, HoldsUntilLatencyAndBoundsMemory) {
+  StampOrderedBuffer<int> b(1.0, 3);
+  b.push(10.0, "a", 1);
+  EXPECT_TRUE(b.release(10.5).empty());
+  EXPECT_EQ(b.release(11.0).size(), 1u);
+  for (int i = 0; i < 5; ++i) b.push(20.0 + i, "a", i);
+  auto out = b.release(0.0);  // over the bound: the two oldest are forced out
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_DOUBLE_EQ(out[0].first, 20.0);
+  EXPECT_EQ(b.forcedReleases(), 2u);
+  EXPECT_EQ(b.size(), 3u);
+}

@@ -44,8 +44,9 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("camera_weight", fo.camera_weight, fo.camera_weight);
   fusion_ = sensors::LidarCameraFusion(fo);
 
-  std::string model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
-  pnh_.param("model_file", model, model);
+  const std::string default_model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
+  std::string model = pnh_.param("model_file", default_model);
+  if (model.empty()) model = default_model;  // config/vision.yaml documents "" as the shipped model
   try {
     auto classifier = std::make_shared<sensors::LegClassifier>();
     classifier->load(model);
