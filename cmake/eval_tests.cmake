@@ -11,3 +11,6 @@ if(TARGET farm_sim AND TARGET gnss_ingest AND TARGET rfid_ranging AND TARGET leg
   target_link_libraries(test_eval_graph_vs_runner picker_localisation_ros picker_localisation_experiment)
   add_dependencies(test_eval_graph_vs_runner evaluator farm_sim gnss_ingest rfid_ranging leg_detector tpf_tracker)
 endif()
+add_rostest_gtest(test_evaluator_node test/evaluator.test test/test_evaluator_node.cpp)
+target_link_libraries(test_evaluator_node picker_localisation_ros)
+add_dependencies(test_evaluator_node evaluator)
