@@ -224,6 +224,11 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_
   reset_srv_ = nh.advertiseService(base + "/reset", &TpfTracker::reset, this);
   what_if_srv_ = nh.advertiseService(base + "/what_if", &TpfTracker::whatIf, this);
   sub_ = nh.subscribe(observations_topic, 200, &TpfTracker::observationCallback, this);
+  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
+  ordering_ = core::StampOrderedBuffer<std::pair<core::Observation, std::string>>(std::max(0.0, ordering_latency_));
+  if (ordering_latency_ > 0.0)
+    ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
+                                     &TpfTracker::orderingCallback, this);
   if (params.prediction_rate > 0.0) {
     prediction_period_ = 1.0 / params.prediction_rate;
     // Ticks at 4x the rate so a prediction happens within a quarter period of falling due.
@@ -245,33 +250,58 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
     return;
   }
   std::size_t unknown = 0;
-  const core::Observation obs = fromMsg(*msg, *map_, &unknown);
+  core::Observation obs = fromMsg(*msg, *map_, &unknown);
   if (unknown > 0) {
     unknown_nodes_ += unknown;
-    ROS_WARN_THROTTLE(5.0,
-                      "tpf_tracker %s: %zu node name(s) of a %s observation are not in the map (skipped)",
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %zu node name(s) of a %s observation are not in the map (skipped)",
                       picker_id_.c_str(), unknown, msg->sensor.c_str());
   }
+  if (ordering_latency_ <= 0.0) {
+    process(obs, msg->sensor);
+    return;
+  }
+  // Tie-break equal stamps by content so the fusion order never depends on arrival order.
+  std::string key = msg->sensor + "|" + msg->robot_id + "|" + msg->picker_id + "|";
+  for (std::size_t i = 0; i < msg->nodes.size() && i < msg->likelihood.size(); ++i)
+    key += msg->nodes[i] + ":" + std::to_string(msg->likelihood[i]) + ",";
+  ordering_.push(obs.stamp, key, {std::move(obs), msg->sensor});
+}
+
+void TpfTracker::orderingCallback(const ros::TimerEvent&) {
+  const double now = ros::Time::now().toSec();
+  if (now <= 0.0) return;
+  for (auto& item : ordering_.release(now)) process(item.second.first, item.second.second);
+}
+
+void TpfTracker::predictDueUntil(double until) {
+  if (prediction_period_ <= 0.0) return;
+  while (filter_->initialised() && until - filter_->lastStamp() >= prediction_period_) {
+    if (!filter_->predictTo(filter_->lastStamp() + prediction_period_)) break;
+    publish();
+  }
+}
+
+void TpfTracker::process(const core::Observation& obs, const std::string& sensor) {
+  if (std::isfinite(obs.stamp)) predictDueUntil(obs.stamp);
   const tpf::UpdateResult r = filter_->update(obs);
   if (!r.ok()) {
     if (r.status != tpf::UpdateStatus::kIgnoredSensor) {
       last_problem_ = std::string(tpf::toString(r.status)) + ": " + r.reason;
-      ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", picker_id_.c_str(), msg->sensor.c_str(),
+      ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", picker_id_.c_str(), sensor.c_str(),
                         last_problem_.c_str());
     }
     return;
   }
   if (r.reinitialised)
-    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", picker_id_.c_str(),
-                      filter_->belief().jsd);
+    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", picker_id_.c_str(), filter_->belief().jsd);
   publish();
 }
 
 void TpfTracker::timerCallback(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   if (now <= 0.0 || !filter_->initialised()) return;  // sim clock not running yet / nothing to predict
-  if (now - filter_->lastStamp() < prediction_period_) return;
-  if (filter_->predictTo(now)) publish();
+  // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
+  predictDueUntil(now - std::max(0.0, ordering_latency_));
 }
 
 bool TpfTracker::reset(picker_localisation::ResetBelief::Request&,
@@ -336,6 +366,8 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   last_diag_time_ = now;
   last_diag_received_ = received_;
   stat.add("observations received", received_);
+  stat.add("observations waiting for stamp order", ordering_.size());
+  stat.add("ordering overflows", ordering_.forcedReleases());
   stat.add("accepted", c.accepted);
   stat.add("reordered (late, within window)", c.reordered);
   stat.add("dropped (too old)", c.dropped_too_old);
