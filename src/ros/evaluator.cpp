@@ -1,6 +1,7 @@
 #include "picker_localisation/ros/evaluator.h"
 
 #include <cmath>
+#include <limits>
 #include <iostream>
 
 #include "picker_localisation/TrackingError.h"
@@ -21,6 +22,7 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("sample_rate", sample_rate, sample_rate);
   pnh.param("duration", duration_, 0.0);
   pnh.param<std::string>("output_csv", output_csv_, "");
+  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
   if (!(sample_rate > 0.0)) {
     ROS_FATAL("evaluator: ~sample_rate must be > 0 (got %g)", sample_rate);
     return;
@@ -49,7 +51,9 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
-  timer_ = nh.createTimer(ros::Duration(1.0 / sample_rate), &Evaluator::onTimer, this);
+  sample_period_ = 1.0 / sample_rate;
+  // The timer only polls; samples fall on the stamp grid (see the header).
+  timer_ = nh.createTimer(ros::Duration(std::min(sample_period_, 0.1)), &Evaluator::onTimer, this);
   ROS_INFO("evaluator: %zu pickers, map '%s', sampling at %g Hz%s", pickers_.size(), map_->name().c_str(),
            sample_rate,
            duration_ > 0.0
@@ -68,7 +72,7 @@ void Evaluator::onBelief(std::size_t i, const picker_localisation::PickerBelief:
                       msg->estimated_node.c_str());
     return;
   }
-  p.estimated_node = msg->estimated_node;
+  p.belief_history.emplace_back(msg->header.stamp.toSec(), msg->estimated_node);
 }
 
 void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg) {
@@ -80,21 +84,37 @@ void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPt
     ROS_WARN_THROTTLE(5.0, "evaluator: non-finite ground truth of %s (ignored)", p.id.c_str());
     return;
   }
-  p.truth = t;
+  p.truth_history.emplace_back(msg->header.stamp.toSec(), t);
   if (first_truth_ < 0.0)
     first_truth_ = msg->header.stamp.isZero() ? ros::Time::now().toSec() : msg->header.stamp.toSec();
 }
 
-void Evaluator::onTimer(const ros::TimerEvent& ev) {
-  if (done_) return;
-  const ros::Time now = ev.current_expected;
+namespace {
+// Latest entry stamped <= t (entries arrive roughly in stamp order; scans from the back), and drops entries
+// that a later one already supersedes for every future t' >= t.
+template <class T>
+std::optional<T> latestAtOrBefore(std::deque<std::pair<double, T>>& history, double t) {
+  std::optional<T> found;
+  double best = -std::numeric_limits<double>::infinity();
+  for (const auto& [stamp, value] : history)
+    if (stamp <= t && stamp >= best) {  // >=: of equal stamps the later arrival wins
+      best = stamp;
+      found = value;
+    }
+  while (history.size() > 1 && history[1].first <= t) history.pop_front();
+  return found;
+}
+}  // namespace
+
+void Evaluator::sampleAt(double t) {
   for (Picker& p : pickers_) {
+    if (auto n = latestAtOrBefore(p.belief_history, t)) p.estimated_node = *n;
+    if (auto x = latestAtOrBefore(p.truth_history, t)) p.truth = *x;
     if (!p.estimated_node || !p.truth) continue;
-    const eval::ErrorSample s =
-        eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, now.toSec(), p.id);
+    const eval::ErrorSample s = eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, t, p.id);
     p.samples.push_back(s);
     picker_localisation::TrackingError msg;
-    msg.header.stamp = now;
+    msg.header.stamp = ros::Time(t);
     msg.header.frame_id = "map";
     msg.picker_id = p.id;
     msg.estimated_node = *p.estimated_node;
@@ -104,9 +124,19 @@ void Evaluator::onTimer(const ros::TimerEvent& ev) {
     msg.in_true_lane = s.in_true_lane;
     p.error_pub.publish(msg);
   }
+}
+
+void Evaluator::onTimer(const ros::TimerEvent&) {
+  if (done_ || first_truth_ < 0.0) return;
+  const double now = ros::Time::now().toSec();
+  if (next_sample_ < 0.0) next_sample_ = std::ceil(first_truth_ / sample_period_) * sample_period_;
+  while (!done_ && next_sample_ <= now - ordering_latency_) {
+    sampleAt(next_sample_);
+    if (duration_ > 0.0 && next_sample_ >= first_truth_ + duration_) done_ = true;
+    next_sample_ += sample_period_;
+  }
   diagnostics_.update();
-  if (duration_ > 0.0 && first_truth_ >= 0.0 && now.toSec() >= first_truth_ + duration_) {
-    done_ = true;
+  if (done_) {
     finish();
     ros::shutdown();
   }

@@ -7,13 +7,17 @@
 //   parameters  ~pickers_file (required), ~sample_rate (1.0 Hz, ROS time), ~duration (0: none; s of ROS time
 //   after
 //               the first ground truth, then the table is printed and the node exits: end it with
-//               required="true"), ~output_csv ("" none: per-sample CSV at exit)
+//               required="true"), ~output_csv ("" none: per-sample CSV at exit), ~ordering_latency (1.5 s)
+// Deterministic sampling (replay): samples fall on t_k = k / sample_rate of message time and are taken once ROS
+// time passes t_k + ordering_latency, pairing the latest belief stamped <= t_k with the latest ground truth
+// stamped <= t_k. So the errors depend on the messages' stamps, never on when a timer fired.
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
 
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,8 +43,10 @@ class Evaluator {
  private:
   struct Picker {
     std::string id;
-    std::optional<std::string> estimated_node;
+    std::optional<std::string> estimated_node;  // latest at the last sample
     std::optional<Eigen::Vector2d> truth;
+    std::deque<std::pair<double, std::string>> belief_history;     // (stamp, estimated node), by arrival
+    std::deque<std::pair<double, Eigen::Vector2d>> truth_history;  // (stamp, position)
     ros::Subscriber belief_sub, truth_sub;
     ros::Publisher error_pub;
     std::vector<eval::ErrorSample> samples;
@@ -56,6 +62,9 @@ class Evaluator {
   std::vector<Picker> pickers_;
   double duration_ = 0.0;
   double first_truth_ = -1.0;  // ROS time of the first ground truth, s
+  double sample_period_ = 1.0, ordering_latency_ = 1.5;
+  double next_sample_ = -1.0;  // next grid time t_k to sample, s
+  void sampleAt(double t);
   std::string output_csv_;
   ros::Timer timer_;
   diagnostic_updater::Updater diagnostics_;
