@@ -88,3 +88,25 @@ TEST(ObservationConversions, RoundTripAndUnknownNodes) {
   msg.likelihood.pop_back();
   EXPECT_NE(core::validateObservation(ros_adapter::fromMsg(msg, map), map), "");
 }
+
+#include "picker_localisation/ros/detection_markers.h"
+
+TEST(DetectionMarkers, OneBodyAndLabelPerPersonAfterAClear) {
+  picker_localisation::PersonDetectionArray people;
+  people.header.frame_id = "map";
+  people.detections.resize(2);
+  people.detections[0].position.x = 3.0;
+  people.detections[0].sensor = "lidar";
+  people.detections[0].confidence = 0.5;
+  people.detections[0].track_id = 7;
+  people.detections[1].sensor = "lidar_camera";
+  people.detections[1].track_id = -1;
+  visualization_msgs::MarkerArray m = ros_adapter::personMarkers(people);
+  ASSERT_EQ(m.markers.size(), 5u);
+  EXPECT_EQ(m.markers[0].action, visualization_msgs::Marker::DELETEALL);
+  EXPECT_DOUBLE_EQ(m.markers[1].pose.position.x, 3.0);
+  EXPECT_EQ(m.markers[2].text, "#7 lidar");
+  EXPECT_EQ(m.markers[4].text, "lidar_camera");
+  EXPECT_GT(m.markers[3].color.g, m.markers[1].color.g);  // camera-confirmed people are green
+  EXPECT_EQ(m.markers[1].header.frame_id, "map");
+}

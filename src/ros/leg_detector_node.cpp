@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "picker_localisation/core/observation.h"
+#include "picker_localisation/ros/detection_markers.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/vision_io.h"
@@ -82,6 +83,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   std::string observations_topic = "/observations";
   pnh_.param("observations_topic", observations_topic, observations_topic);
   people_pub_ = nh_.advertise<picker_localisation::PersonDetectionArray>("people", 10);
+  people_markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("people/markers", 2);
   if (map_) obs_pub_ = nh_.advertise<picker_localisation::Observation>(observations_topic, 50);
 
   diagnostics_.setHardwareID(robot_id_.empty() ? "leg_detector" : robot_id_);
@@ -261,6 +263,7 @@ void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::
   }
   people_ += out.detections.size();
   people_pub_.publish(out);
+  if (people_markers_pub_.getNumSubscribers() > 0) people_markers_pub_.publish(personMarkers(out));
 }
 
 void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {

@@ -66,7 +66,7 @@ class LegDetectorNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   std::vector<ros::Subscriber> subs_;
-  ros::Publisher people_pub_, obs_pub_;
+  ros::Publisher people_pub_, obs_pub_, people_markers_pub_;
   picker_localisation::BearingDetectionArray::ConstPtr last_detections_;
   sensor_msgs::CameraInfo::ConstPtr camera_info_;
   diagnostic_updater::Updater diagnostics_;
