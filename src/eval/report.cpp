@@ -184,8 +184,12 @@ void drawPanel(cv::Mat& img, const cv::Rect& area, const std::vector<ErrorSeries
     cv::putText(img, l.str(), cv::Point(area.x - 45, p.y + 4), cv::FONT_HERSHEY_SIMPLEX, 0.4,
                 cv::Scalar(0, 0, 0));
   }
-  for (int k = 0; k <= 5; ++k) {  // t ticks
-    const double t = t_max * k / 5.0;
+  // t ticks at a round step (1, 2 or 5 x 10^k s), about five of them
+  const double raw_step = t_max / 5.0;
+  const double decade = std::pow(10.0, std::floor(std::log10(raw_step)));
+  const double step =
+      raw_step / decade < 2.0 ? 2.0 * decade : (raw_step / decade < 5.0 ? 5.0 * decade : 10.0 * decade);
+  for (double t = 0.0; t <= t_max + 1e-9; t += step) {
     const cv::Point p = px(t, 0.0);
     std::ostringstream l;
     l << std::fixed << std::setprecision(0) << t;
