@@ -368,11 +368,25 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
   std::unique_ptr<nbs::NextBestSensePlanner> planner;
   std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources;
+  double replan_period = config.replan_period, battery_level = 1.0;
   if (spec.policy != RobotPolicy::kPatrol) {
-    nbs::PlannerConfig pc;
+    // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
+    // what_if_seed); the method sets the policy.
+    const std::string nbs_file = resolveConfigFile(config.nbs_config, "nbs.yaml");
+    nbs::PlannerConfig pc =
+        nbs_file.empty() ? nbs::PlannerConfig() : nbs::PlannerConfig::fromYamlFile(nbs_file);
+    std::uint64_t what_if_seed = 1;
+    if (!nbs_file.empty()) {
+      const YAML::Node y = YAML::LoadFile(nbs_file);
+      readKey(y, "planning_period", replan_period);
+      readKey(y, "battery_level", battery_level);
+      readKey(y, "what_if_seed", what_if_seed);
+    }
     pc.policy = spec.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
     planner = std::make_unique<nbs::NextBestSensePlanner>(map, pc);
-    for (auto& t : tracks) sources.push_back(std::make_unique<nbs::TpfBeliefSource>(t.id, *t.tpf));
+    for (auto& t : tracks)
+      sources.push_back(
+          std::make_unique<nbs::TpfBeliefSource>(t.id, *t.tpf, what_if_seed ? what_if_seed : 1));
   }
   double last_plan = -1e300;
 #endif
@@ -467,10 +481,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         t.tpf->predictTo(now);
 #endif
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
-    if (planner && (simulator.robot(0).atGoal() || now - last_plan >= config.replan_period)) {
+    if (planner && (simulator.robot(0).atGoal() || now - last_plan >= replan_period)) {
       std::vector<nbs::BeliefSource*> views;
       for (auto& s : sources) views.push_back(s.get());
-      const nbs::PlanResult plan = planner->plan(simulator.robot(0).currentNode(), 1.0, views);
+      const nbs::PlanResult plan = planner->plan(simulator.robot(0).currentNode(), battery_level, views);
       if (plan.ok()) simulator.setRobotGoal(0, plan.ranked.front().node);
       last_plan = now;
     }

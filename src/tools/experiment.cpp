@@ -3,7 +3,7 @@
 //              [--duration SEC] --out DIR [--jobs J] [--sample-period SEC] [--leg-model FILE] [--tpf-config
 //              FILE]
 //              [--sim-config FILE] [--datum FILE] [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE]
-//              [--tracker-seed N]
+//              [--nbs-config FILE] [--tracker-seed N]
 // Exit status: 0 success, 2 bad arguments / map / output directory.
 #include <cstdlib>
 #include <iostream>
@@ -19,7 +19,8 @@ void usage(std::ostream& o) {
   o << "usage: experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N]\n"
        "                  [--seed S] [--duration SEC] --out DIR [--jobs J] [--sample-period SEC]\n"
        "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
-       "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--tracker-seed N]\n"
+       "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--nbs-config FILE]\n"
+       "                  [--tracker-seed N]\n"
        "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in "
        "defaults\n"
        "methods:";

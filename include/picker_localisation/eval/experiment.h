@@ -58,6 +58,7 @@ struct RunConfig {
   std::string pickers_file;        // pickers (the first 1 or 3 entries), config/pickers.yaml
   std::string gnss_config;         // GnssIngest options, config/gnss_ingest.yaml
   std::string rfid_config;         // RfidObservationModel options, config/rfid_ranging.yaml
+  std::string nbs_config;          // planner of estimated_node / nbs, config/nbs.yaml
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
 };
 
