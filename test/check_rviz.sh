@@ -2,7 +2,7 @@
 # rviz loads rviz/picker_localisation.rviz under Xvfb and renders: the process stays up, the log reports no
 # config/plugin errors, and a screenshot of the screen is not blank. Usage: check_rviz.sh OUT.png [LAUNCH]
 set -u
-out="${1:-/tmp/rviz.png}"
+out="${1:-$(mktemp --suffix=.png)}"
 launch="${2:-$(rospack find picker_localisation)/test/rviz_check.launch}"
 settle="${RVIZ_SETTLE:-12}"
 export PATH=/usr/bin:$PATH
