@@ -1,4 +1,5 @@
 // rostest: topological_map_server publishes the Riseholme map and its markers latched, and serves the map.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <picker_localisation/GetTopologicalMap.h>
 #include <picker_localisation/TopologicalMap.h>
@@ -44,6 +45,23 @@ TEST(MapServer, Service) {
   picker_localisation::GetTopologicalMap srv;
   ASSERT_TRUE(ros::service::call("/get_topological_map", srv));
   EXPECT_EQ(srv.response.map.nodes.size(), 138u);
+}
+
+TEST(MapServer, Diagnostics) {
+  bool found = false;
+  for (int i = 0; i < 10 && !found; ++i) {
+    auto d = ros::topic::waitForMessage<diagnostic_msgs::DiagnosticArray>("/diagnostics", ros::Duration(5.0));
+    ASSERT_TRUE(d);
+    for (const auto& s : d->status)
+      if (s.name.find("topological map") != std::string::npos) {
+        found = true;
+        EXPECT_EQ(s.level, diagnostic_msgs::DiagnosticStatus::OK);
+        bool nodes = false;
+        for (const auto& kv : s.values) nodes |= (kv.key == "nodes" && kv.value == "138");
+        EXPECT_TRUE(nodes);
+      }
+  }
+  EXPECT_TRUE(found);
 }
 
 int main(int argc, char** argv) {

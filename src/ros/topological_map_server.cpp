@@ -28,13 +28,37 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
     marker_pub_.publish(mapMarkers(map, frame_id, node_scale, labels));
     ROS_INFO("topological_map_server: '%s' from %s: %zu nodes, %zu directed edges, %zu lanes", map.name().c_str(),
              map_file.c_str(), map.numNodes(), map.numDirectedEdges(), map.numLanes());
+    lanes_ = map.numLanes();
+    components_ = map.numComponents();
+    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh);
+    diagnostics_->setHardwareID(map_file);
+    diagnostics_->add("topological map", this, &TopologicalMapServer::diagnose);
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+      diagnostics_->update();
+    });
     ok_ = true;
   } catch (const topology::MapError& e) {
     ROS_FATAL("topological_map_server: %s", e.what());
   }
 }
 
+void TopologicalMapServer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  // A map split into several components strands pickers: worth a warning, not an error.
+  if (components_ > 1)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "map has " + std::to_string(components_) + " components");
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "map loaded");
+  stat.add("map", msg_.name);
+  stat.add("source file", msg_.source_file);
+  stat.add("nodes", msg_.nodes.size());
+  stat.add("directed edges", msg_.edges.size());
+  stat.add("lanes", lanes_);
+  stat.add("components", components_);
+  stat.add("service requests", requests_);
+}
+
 bool TopologicalMapServer::serveMap(GetTopologicalMap::Request&, GetTopologicalMap::Response& res) {
+  ++requests_;
   res.map = msg_;
   return true;
 }

@@ -1,8 +1,11 @@
 // ROS adapter: load a topological map and publish it latched with its rviz markers.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/GetTopologicalMap.h>
 #include <ros/ros.h>
+
+#include <memory>
 
 #include "picker_localisation/topology/topological_map.h"
 
@@ -17,11 +20,15 @@ class TopologicalMapServer {
 
  private:
   bool serveMap(GetTopologicalMap::Request&, GetTopologicalMap::Response& res);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   bool ok_ = false;
   picker_localisation::TopologicalMap msg_;
   ros::Publisher map_pub_, marker_pub_;
   ros::ServiceServer service_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  ros::WallTimer diagnostics_timer_;  // wall time: reports even while a simulated clock is paused
+  std::size_t lanes_ = 0, components_ = 0, requests_ = 0;
 };
 
 }  // namespace ros_adapter
