@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/topology/map_io.h"
 
 using namespace picker_localisation;
@@ -109,4 +110,32 @@ TEST(DetectionMarkers, OneBodyAndLabelPerPersonAfterAClear) {
   EXPECT_EQ(m.markers[4].text, "lidar_camera");
   EXPECT_GT(m.markers[3].color.g, m.markers[1].color.g);  // camera-confirmed people are green
   EXPECT_EQ(m.markers[1].header.frame_id, "map");
+}
+
+TEST(ParamYaml, NestedXmlRpcBecomesYaml) {
+  XmlRpc::XmlRpcValue params;
+  params["flag"] = true;
+  params["count"] = 20;
+  params["rate"] = 2.5;
+  params["method"] = std::string("tpf");
+  params["list"][0] = 1;
+  params["list"][1] = std::string("b");
+  params["energy"]["capacity"] = 100.0;
+  const XmlRpc::XmlRpcValue& in = params;
+  YAML::Node y = ros_adapter::toYaml(in);
+  ASSERT_TRUE(y.IsMap());
+  EXPECT_EQ(y.size(), 6u);
+  EXPECT_TRUE(y["flag"].as<bool>());
+  EXPECT_EQ(y["count"].as<int>(), 20);
+  EXPECT_DOUBLE_EQ(y["count"].as<double>(), 20.0);  // ints read as doubles (e.g. horizon_m: 20)
+  EXPECT_DOUBLE_EQ(y["rate"].as<double>(), 2.5);
+  EXPECT_EQ(y["method"].as<std::string>(), "tpf");
+  ASSERT_TRUE(y["list"].IsSequence());
+  ASSERT_EQ(y["list"].size(), 2u);
+  EXPECT_EQ(y["list"][0].as<int>(), 1);
+  EXPECT_EQ(y["list"][1].as<std::string>(), "b");
+  ASSERT_TRUE(y["energy"].IsMap());
+  EXPECT_DOUBLE_EQ(y["energy"]["capacity"].as<double>(), 100.0);
+  EXPECT_EQ(params.size(), 6);  // the input is left as it was
+  EXPECT_TRUE(ros_adapter::toYaml(XmlRpc::XmlRpcValue()).IsNull());  // invalid -> null
 }

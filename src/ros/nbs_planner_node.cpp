@@ -9,38 +9,13 @@
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/ros/map_conversions.h"
 #include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/what_if_belief_source.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
 namespace {
-
-YAML::Node toYaml(const XmlRpc::XmlRpcValue& v) {
-  XmlRpc::XmlRpcValue x = v;  // the accessors are non-const
-  switch (x.getType()) {
-    case XmlRpc::XmlRpcValue::TypeBoolean:
-      return YAML::Node(static_cast<bool>(x));
-    case XmlRpc::XmlRpcValue::TypeInt:
-      return YAML::Node(static_cast<int>(x));
-    case XmlRpc::XmlRpcValue::TypeDouble:
-      return YAML::Node(static_cast<double>(x));
-    case XmlRpc::XmlRpcValue::TypeString:
-      return YAML::Node(static_cast<std::string>(x));
-    case XmlRpc::XmlRpcValue::TypeArray: {
-      YAML::Node n(YAML::NodeType::Sequence);
-      for (int i = 0; i < x.size(); ++i) n.push_back(toYaml(x[i]));
-      return n;
-    }
-    case XmlRpc::XmlRpcValue::TypeStruct: {
-      YAML::Node n(YAML::NodeType::Map);
-      for (auto it = x.begin(); it != x.end(); ++it) n[it->first] = toYaml(it->second);
-      return n;
-    }
-    default:
-      return YAML::Node();
-  }
-}
 
 std_msgs::ColorRGBA utilityColour(double u) {
   // red (0) -> yellow (0.5) -> green (1)
