@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <limits>
 #include <random>
 
@@ -247,9 +248,58 @@ TEST(GnssIngest, VelocityOverTheLastTenFixesAndBlackouts) {
 // ---------------------------------------------------------------------------------------------------------
 // RFID
 
+// Logistic read model with the simulator's defaults (p_max 0.95, d50 4 m, width 0.7 m, max_range 8 m,
+// min_relative 0.01). Hand-computed: p_read(0) = 0.95 / (1 + e^(-40/7)) = 0.94687672168,
+// p_read(4) = 0.95 / 2 = 0.475, p_read(5) = 0.95 / (1 + e^(10/7)) = 0.18365530131,
+// p_read(7) = 0.95 / (1 + e^(30/7)) = 0.01289807110; cut-off r_c = 4 + 0.7 ln 99 = 7.2166 m.
+TEST(RfidObservationModel, LogisticReadProbabilityLikelihood) {
+  auto map = latticeMap(10.0, 1.0);
+  RfidModelOptions o;
+  o.negative_information = false;
+  RfidObservationModel rfid(twoPickers(), map, o);
+  EXPECT_NEAR(rfid.regionRadius(), 7.2165838951, 1e-9);
+  EXPECT_NEAR(rfid.readProbability(0.0), 0.9468767217, 1e-9);
+  EXPECT_NEAR(rfid.readProbability(4.0), 0.475, 1e-12);
+  EXPECT_EQ(rfid.readProbability(8.5), 0.0);  // beyond max_range
+  RfidRead read;
+  read.stamp = 1.0;
+  read.robot_id = "robot_1";
+  read.antenna_id = "robot_1/rfid_antenna";
+  read.tag_id = "rfid_2";
+  RfidResult r = rfid.process(read);
+  ASSERT_TRUE(r.accepted());
+  const core::Observation& obs = *r.observation;
+  EXPECT_EQ(core::validateObservation(obs, *map), "");
+  // Lattice points with x^2 + y^2 <= 7.2166^2: 169 (counted by hand/script over the 21 x 21 lattice).
+  EXPECT_EQ(obs.nodes.size(), 169u);
+  EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 0, 0)), 0.9468767217, 1e-9);
+  EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 4, 0)), 0.475, 1e-12);
+  EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 0, -4)), 0.475, 1e-12);
+  EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 5, 0)), 0.1836553013, 1e-9);
+  EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 7, 0)), 0.0128980711, 1e-9);
+  EXPECT_EQ(likelihoodAt(obs, nodeAt(*map, 8, 0)), 0.0);  // p_read(8) / p_max = 0.0033 < min_relative: not listed
+  // A 3 m height difference: 3D distance 5 m for a node 4 m away in the plane.
+  RfidModelOptions oh = o;
+  oh.height_difference = 3.0;
+  RfidObservationModel high(twoPickers(), map, oh);
+  EXPECT_NEAR(high.readProbability(4.0), 0.1836553013, 1e-9);
+  EXPECT_NEAR(high.regionRadius(), std::sqrt(7.2165838951 * 7.2165838951 - 9.0), 1e-9);
+  // Bad parameters.
+  RfidModelOptions bad = o;
+  bad.read_model = "cone";
+  EXPECT_THROW(RfidObservationModel(twoPickers(), map, bad), std::invalid_argument);
+  bad = o;
+  bad.width = 0.0;
+  EXPECT_THROW(RfidObservationModel(twoPickers(), map, bad), std::invalid_argument);
+  bad = o;
+  bad.min_relative = 1.0;
+  EXPECT_THROW(RfidObservationModel(twoPickers(), map, bad), std::invalid_argument);
+}
+
 TEST(RfidObservationModel, ReadRegionLikelihoodAndBadInput) {
   auto map = latticeMap(10.0, 1.0);
   RfidModelOptions o;
+  o.read_model = "disc";
   o.read_range = 2.0;
   o.negative_information = false;
   RfidObservationModel rfid(twoPickers(), map, o);
@@ -298,9 +348,36 @@ TEST(RfidObservationModel, ReadRegionLikelihoodAndBadInput) {
   EXPECT_EQ(rfid.counters().unknown_tag, 1u);
 }
 
+TEST(RfidObservationModel, LogisticNegativeInformation) {
+  auto map = latticeMap(10.0, 1.0);
+  RfidModelOptions o;  // logistic, p_detect 0.7: L(n) = 1 - 0.7 p_read(d) / 0.95
+  o.negative_window = 5.0;
+  o.negative_period = 5.0;
+  RfidObservationModel rfid(twoPickers(), map, o);
+  RfidRead read;
+  read.antenna_id = "a";
+  read.tag_id = "rfid_1";
+  std::size_t negatives = 0;
+  for (int i = 0; i <= 5; ++i) {
+    read.stamp = i;
+    for (const core::Observation& n : rfid.process(read).negative) {
+      ++negatives;
+      EXPECT_EQ(n.picker_id, "picker_2");
+      ASSERT_EQ(n.nodes.size(), map->numNodes());
+      EXPECT_EQ(core::validateObservation(n, *map), "");
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 0, 0)), 1.0 - 0.7 * 0.9468767217 / 0.95, 1e-9);  // 0.30230
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 4, 0)), 0.65, 1e-12);                           // 1 - 0.7 / 2
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 7, 0)), 1.0 - 0.7 * 0.0128980711 / 0.95, 1e-9);  // 0.99050
+      EXPECT_EQ(likelihoodAt(n, nodeAt(*map, 8, 0)), 1.0);  // beyond the cut-off
+    }
+  }
+  EXPECT_EQ(negatives, 1u);
+}
+
 TEST(RfidObservationModel, NegativeInformationForPickersNotRead) {
   auto map = latticeMap(10.0, 1.0);
   RfidModelOptions o;
+  o.read_model = "disc";
   o.read_range = 2.0;
   o.negative_window = 5.0;
   o.negative_period = 5.0;

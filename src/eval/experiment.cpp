@@ -235,6 +235,13 @@ sensors::RfidModelOptions rfidOptions(const std::string& file) {
   sensors::RfidModelOptions o;
   if (file.empty()) return o;
   const YAML::Node y = YAML::LoadFile(file);
+  readKey(y, "read_model", o.read_model);
+  readKey(y, "p_max", o.p_max);
+  readKey(y, "d50", o.d50);
+  readKey(y, "width", o.width);
+  readKey(y, "max_range", o.max_range);
+  readKey(y, "height_difference", o.height_difference);
+  readKey(y, "min_relative", o.min_relative);
   readKey(y, "read_range", o.read_range);
   readKey(y, "beam_half_angle", o.beam_half_angle);
   readKey(y, "min_rssi", o.min_rssi);

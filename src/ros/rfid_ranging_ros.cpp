@@ -12,6 +12,13 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
   sensors::RfidModelOptions o;
+  pnh.param("read_model", o.read_model, o.read_model);
+  pnh.param("p_max", o.p_max, o.p_max);
+  pnh.param("d50", o.d50, o.d50);
+  pnh.param("width", o.width, o.width);
+  pnh.param("max_range", o.max_range, o.max_range);
+  pnh.param("height_difference", o.height_difference, o.height_difference);
+  pnh.param("min_relative", o.min_relative, o.min_relative);
   pnh.param("read_range", o.read_range, o.read_range);
   pnh.param("beam_half_angle", o.beam_half_angle, o.beam_half_angle);
   pnh.param("min_rssi", o.min_rssi, o.min_rssi);

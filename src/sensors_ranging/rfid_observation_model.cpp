@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 namespace picker_localisation {
 namespace sensors {
@@ -23,12 +24,52 @@ RfidObservationModel::RfidObservationModel(core::PickerRegistry registry,
                                            RfidModelOptions options)
     : registry_(std::move(registry)), map_(std::move(map)), options_(options) {
   if (!map_) throw std::invalid_argument("RfidObservationModel: no map");
-  if (!(options_.read_range > 0.0)) throw std::invalid_argument("RfidObservationModel: read_range must be > 0");
   options_.p_detect = std::clamp(options_.p_detect, 0.0, 1.0);
+  if (options_.read_model == "disc") {
+    logistic_ = false;
+    if (!(options_.read_range > 0.0)) throw std::invalid_argument("RfidObservationModel: read_range must be > 0");
+    region_radius_ = options_.read_range;
+    position_variance_ = options_.read_range * options_.read_range / 4.0;  // uniform disc: R^2 / 4 per axis
+    return;
+  }
+  if (options_.read_model != "logistic")
+    throw std::invalid_argument("RfidObservationModel: read_model must be 'logistic' or 'disc', not '" +
+                                options_.read_model + "'");
+  if (!(options_.p_max > 0.0 && options_.p_max <= 1.0))
+    throw std::invalid_argument("RfidObservationModel: p_max must be in (0, 1]");
+  if (!(options_.width > 0.0)) throw std::invalid_argument("RfidObservationModel: width must be > 0");
+  if (!(options_.max_range > 0.0)) throw std::invalid_argument("RfidObservationModel: max_range must be > 0");
+  if (!(options_.min_relative > 0.0 && options_.min_relative < 1.0))
+    throw std::invalid_argument("RfidObservationModel: min_relative must be in (0, 1)");
+  if (!std::isfinite(options_.d50) || !std::isfinite(options_.height_difference))
+    throw std::invalid_argument("RfidObservationModel: d50 and height_difference must be finite");
+  // Cut-off: p_read(d) / p_max >= min_relative  <=>  d <= d50 + width ln(1 / min_relative - 1) (3D distance).
+  const double cutoff_3d = std::min(options_.max_range,
+                                    options_.d50 + options_.width * std::log(1.0 / options_.min_relative - 1.0));
+  const double h2 = options_.height_difference * options_.height_difference;
+  region_radius_ = cutoff_3d * cutoff_3d > h2 ? std::sqrt(cutoff_3d * cutoff_3d - h2) : 0.0;
+  // Position covariance of the read: p_read-weighted second moment over the disc of radius r_c, per axis
+  // 0.5 * int p(r) r^3 dr / int p(r) r dr (midpoint rule; the curve is smooth on [0, r_c]).
+  double m1 = 0.0, m3 = 0.0;
+  const int steps = 1000;
+  const double dr = region_radius_ / steps;
+  for (int i = 0; i < steps; ++i) {
+    const double r = (i + 0.5) * dr, w = readProbability(r);
+    m1 += w * r;
+    m3 += w * r * r * r;
+  }
+  position_variance_ = m1 > 0.0 ? 0.5 * m3 / m1 : 0.01;
+}
+
+double RfidObservationModel::readProbability(double planar_distance) const {
+  if (!logistic_) return planar_distance <= options_.read_range ? 1.0 : 0.0;
+  const double d = std::hypot(planar_distance, options_.height_difference);
+  if (!(d >= 0.0) || d > options_.max_range) return 0.0;
+  return options_.p_max / (1.0 + std::exp((d - options_.d50) / options_.width));
 }
 
 std::vector<topology::NodeIndex> RfidObservationModel::nodesInReadRegion(const Eigen::Vector3d& pose) const {
-  std::vector<topology::NodeIndex> nodes = map_->nodesWithin(pose.head<2>(), options_.read_range);
+  std::vector<topology::NodeIndex> nodes = map_->nodesWithin(pose.head<2>(), region_radius_);
   if (options_.beam_half_angle < M_PI) {
     nodes.erase(std::remove_if(nodes.begin(), nodes.end(),
                                [&](topology::NodeIndex n) {
@@ -81,11 +122,16 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
   obs.picker_id = *picker;
   obs.identifying = true;
   obs.nodes = nodesInReadRegion(read.antenna_pose);
-  if (obs.nodes.empty()) obs.nodes.push_back(map_->nearestNode(read.antenna_pose.head<2>()));
-  obs.likelihood.assign(obs.nodes.size(), 1.0);
+  if (obs.nodes.empty()) {
+    obs.nodes.push_back(map_->nearestNode(read.antenna_pose.head<2>()));
+    obs.likelihood.assign(1, 1.0);
+  } else {
+    obs.likelihood.reserve(obs.nodes.size());
+    for (topology::NodeIndex n : obs.nodes)  // L(n) = p_read(d(n)); the TPF normalises
+      obs.likelihood.push_back(readProbability((map_->position2d(n) - read.antenna_pose.head<2>()).norm()));
+  }
   obs.position = read.antenna_pose.head<2>();
-  // Uniform disc of radius R: variance R^2 / 4 per axis.
-  obs.position_covariance = Eigen::Matrix2d::Identity() * options_.read_range * options_.read_range / 4.0;
+  obs.position_covariance = Eigen::Matrix2d::Identity() * position_variance_;
   result.observation = std::move(obs);
   if (options_.negative_information) result.negative = negativeObservations(read, *picker);
   return result;
@@ -119,8 +165,12 @@ std::vector<core::Observation> RfidObservationModel::negativeObservations(const 
     obs.nodes.resize(map_->numNodes());
     obs.likelihood.assign(map_->numNodes(), 1.0);
     for (topology::NodeIndex n = 0; n < map_->numNodes(); ++n) obs.nodes[n] = n;
-    const double low = std::max(1.0 - options_.p_detect, 1e-6);
-    for (topology::NodeIndex n : inside) obs.likelihood[n] = low;
+    // L(n) = 1 - p_detect * p_read(d(n)) / p_max (disc: 1 - p_detect inside), floored away from 0.
+    const double scale = logistic_ ? options_.p_detect / options_.p_max : options_.p_detect;
+    for (topology::NodeIndex n : inside) {
+      const double p = readProbability((map_->position2d(n) - read.antenna_pose.head<2>()).norm());
+      obs.likelihood[n] = std::max(1.0 - scale * p, 1e-6);
+    }
     last_negative_[key] = read.stamp;
     ++counters_.negative_sent;
     out.push_back(std::move(obs));

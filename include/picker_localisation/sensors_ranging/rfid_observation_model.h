@@ -1,16 +1,29 @@
 // RFID reads of picker tags by a robot's antenna -> identifying Observations (Navigate-and-Seek Sec. IV/VI:
 // an RFID detection is an identifying observation with gamma_RFID = 1). ROS-free.
 //
-// Positive model: a read of a picker's tag by an antenna at pose (x, y, yaw) in the map says the picker is
-// within the antenna's read range: L(n) = 1 for every node n with |n - antenna| <= read_range and (for a
-// directional antenna) |bearing(n) - yaw| <= beam_half_angle; other nodes 0 (not listed). When no node
-// qualifies, the node nearest to the antenna gets L = 1 (an observation is never empty).
-// Negative model (configurable): while an antenna is reading (it has produced reads with gaps shorter than
-// `negative_window` s for at least `negative_window` s), every picker with RFID tags that this antenna has not read within `negative_window`
-// gets, at most once per `negative_period` s, an identifying Observation (sent with each read)
-// with L(n) = 1 - p_detect inside the read region and L(n) = 1 for every other map node (all map nodes are
-// listed, because unlisted nodes mean L = 0). Limitation: an antenna that reads no tag at all is not known
-// to be reading (RfidReading has no "inventory round" event), so it gives no negative information.
+// Sensor model (read_model "logistic", the default): the probability that one read attempt of an antenna
+// reads a tag at distance d is the logistic fall-off
+//   p_read(d) = p_max / (1 + exp((d - d50) / width))  for d <= max_range, 0 beyond,
+// the same family and (by default) the same parameters as the simulator (config/sim.yaml `rfid`,
+// sim::rfidReadProbability). d is the 3D antenna-tag distance sqrt(d_xy^2 + height_difference^2), d_xy the
+// planar distance from the antenna to the map node. Reading the curve as a likelihood over the picker's node:
+//   positive (the tag was read): L(n) = p_read(d(n)), listed only for nodes with p_read(d(n)) >= min_relative *
+//     p_max (the cut-off radius r_c = min(max_range, d50 + width ln(1/min_relative - 1)), about 7.2 m by default,
+//     keeps the observation sparse; beyond it the likelihood is treated as 0);
+//   negative (an antenna that is reading has not read the tag for a window): L(n) = 1 - p_detect * s(d(n))
+//     with s = p_read / p_max in [0, 1] the normalised curve, i.e. p_detect is the probability of at least one
+//     read within the window for a tag next to the antenna and it falls off with the same shape; L = 1
+//     beyond r_c.
+// (read_model "disc" keeps the former hard model: L = 1 inside |n - antenna| <= read_range, 1 - p_detect inside
+// for negative information.) A directional antenna (beam_half_angle < pi) additionally restricts the region to
+// |bearing(n) - yaw| <= beam_half_angle. When no node is inside the region, the node nearest to the antenna gets
+// L = 1 (an observation is never empty).
+// Negative information (configurable): while an antenna is reading (it has produced reads with gaps shorter than
+// `negative_window` s for at least `negative_window` s), every picker with RFID tags that this antenna has not
+// read within `negative_window` gets, at most once per `negative_period` s, an identifying Observation (sent with
+// each read) with the negative likelihood above inside the region and L(n) = 1 for every other map node (all map
+// nodes are listed, because unlisted nodes mean L = 0). Limitation: an antenna that reads no tag at all is not
+// known to be reading (RfidReading has no "inventory round" event), so it gives no negative information.
 #pragma once
 
 #include <Eigen/Core>
@@ -44,6 +57,15 @@ const char* toString(RfidRejection r);
 
 struct RfidModelOptions {
   std::string sensor = "rfid";
+  std::string read_model = "logistic";  // "logistic" (p_read(d), see above) or "disc" (hard read_range disc)
+  // logistic model; defaults equal the simulator's documented defaults (config/sim.yaml rfid)
+  double p_max = 0.95;                // read probability per attempt next to the antenna
+  double d50 = 4.0;                   // m, distance where p_read = p_max / 2
+  double width = 0.7;                 // m, steepness of the fall-off
+  double max_range = 8.0;             // m, p_read = 0 beyond
+  double height_difference = 0.0;     // m, antenna height minus tag height (sim: both 1.0 m)
+  double min_relative = 0.01;         // nodes with p_read < min_relative * p_max are not listed (sparsity cut-off)
+  // disc model
   double read_range = 3.0;            // m, radius of the read region around the antenna
   double beam_half_angle = 3.14159265358979323846;  // rad, half opening of the read region (pi: omnidirectional)
   double min_rssi = -1e9;             // dBm, weaker reads are rejected as unreliable (default: accept all)
@@ -73,8 +95,13 @@ class RfidObservationModel {
                        RfidModelOptions options = {});
 
   RfidResult process(const RfidRead& read);
-  // Map nodes inside the read region of an antenna at pose (x, y, yaw), sorted.
+  // Map nodes inside the read region of an antenna at pose (x, y, yaw), sorted: within regionRadius() (and the
+  // beam).
   std::vector<topology::NodeIndex> nodesInReadRegion(const Eigen::Vector3d& antenna_pose) const;
+  // Radius of the read region: read_range (disc) or the cut-off radius r_c (logistic).
+  double regionRadius() const { return region_radius_; }
+  // p_read at planar distance d_xy from the antenna (disc model: 1 inside read_range, 0 outside).
+  double readProbability(double planar_distance) const;
 
   const RfidCounters& counters() const { return counters_; }
   const RfidModelOptions& options() const { return options_; }
@@ -85,6 +112,9 @@ class RfidObservationModel {
   core::PickerRegistry registry_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   RfidModelOptions options_;
+  bool logistic_ = true;
+  double region_radius_ = 0.0;
+  double position_variance_ = 0.0;  // per axis, of the read-region position (p_read-weighted)
   std::map<std::string, double> antenna_last_stamp_;                            // antenna -> newest read
   std::map<std::string, double> antenna_session_start_;  // antenna -> first read of its current reading spell
   std::map<std::pair<std::string, std::string>, double> last_read_;             // (antenna, picker) -> stamp
