@@ -253,6 +253,48 @@ sensors::RfidModelOptions rfidOptions(const std::string& file) {
   return o;
 }
 
+#ifdef PL_HAVE_VISION
+// The leg_detector node's options from the `leg_detector:` section of config/vision.yaml and, as demo.launch
+// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.3: the
+// classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files override earlier ones.
+std::vector<std::string> visionConfigFiles(const std::string& value) {
+  std::vector<std::string> files;
+  if (value == "none") return files;
+  if (value.empty()) {
+    for (const char* f : {"vision.yaml", "vision_sim.yaml"}) {
+      const std::string p = resolveConfigFile("", f);
+      if (!p.empty()) files.push_back(p);
+    }
+    return files;
+  }
+  std::stringstream ss(value);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) files.push_back(item);
+  return files;
+}
+
+void visionOptions(const std::string& value, sensors::LegDetectorOptions& lo, sensors::ClusterTrackerOptions& to) {
+  for (const auto& file : visionConfigFiles(value)) {
+    const YAML::Node root = YAML::LoadFile(file);
+    const YAML::Node y = root["leg_detector"];
+    if (!y) continue;
+    readKey(y, "leg_threshold", lo.leg_threshold);
+    readKey(y, "max_leg_range", lo.max_leg_range);
+    readKey(y, "max_pair_distance", lo.max_pair_distance);
+    readKey(y, "single_leg_people", lo.single_leg_people);
+    readKey(y, "jump_distance", lo.segmentation.jump_distance);
+    int min_points = static_cast<int>(lo.segmentation.min_points);
+    readKey(y, "min_cluster_points", min_points);
+    lo.segmentation.min_points = static_cast<std::size_t>(std::max(1, min_points));
+    readKey(y, "gate_distance", to.gate_distance);
+    readKey(y, "hits_to_confirm", to.hits_to_confirm);
+    readKey(y, "misses_to_delete", to.misses_to_delete);
+    readKey(y, "tentative_misses", to.tentative_misses);
+  }
+}
+#endif
+
 sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
   sensors::DatumConfig c;
   c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
@@ -335,11 +377,15 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
       registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
   std::unique_ptr<sensors::LegDetector> legs;
-  sensors::ClusterTracker leg_tracks;  // as the leg_detector node: one tracker over both lasers, map frame
+  sensors::LegDetectorOptions leg_options;
+  sensors::ClusterTrackerOptions leg_track_options;
+  if (spec.lidar) visionOptions(config.vision_config, leg_options, leg_track_options);
+  // as the leg_detector node: one tracker over both lasers, map frame
+  sensors::ClusterTracker leg_tracks(leg_track_options);
   if (spec.lidar) {
     auto classifier = std::make_shared<sensors::LegClassifier>();
     classifier->load(legModelPath(config));
-    legs = std::make_unique<sensors::LegDetector>(classifier);
+    legs = std::make_unique<sensors::LegDetector>(classifier, leg_options);
   }
 #endif
 

@@ -3,7 +3,7 @@
 //              [--duration SEC] --out DIR [--jobs J] [--sample-period SEC] [--leg-model FILE] [--tpf-config
 //              FILE]
 //              [--sim-config FILE] [--datum FILE] [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE]
-//              [--nbs-config FILE] [--tracker-seed N]
+//              [--nbs-config FILE] [--vision-config FILE[,FILE...]] [--tracker-seed N]
 // Exit status: 0 success, 2 bad arguments / map / output directory.
 #include <cstdlib>
 #include <iostream>
@@ -20,7 +20,7 @@ void usage(std::ostream& o) {
        "                  [--seed S] [--duration SEC] --out DIR [--jobs J] [--sample-period SEC]\n"
        "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
        "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--nbs-config FILE]\n"
-       "                  [--tracker-seed N]\n"
+       "                  [--vision-config FILE[,FILE...]] [--tracker-seed N]\n"
        "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in "
        "defaults\n"
        "methods:";
@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
         cfg.run.gnss_config = v;
       else if (a == "--rfid-config")
         cfg.run.rfid_config = v;
+      else if (a == "--vision-config")
+        cfg.run.vision_config = v;
       else if (a == "--tracker-seed")
         cfg.run.tracker_seed = std::stoull(v);
       else
