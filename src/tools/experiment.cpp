@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
         cfg.run.gnss_config = v;
       else if (a == "--rfid-config")
         cfg.run.rfid_config = v;
+      else if (a == "--nbs-config")
+        cfg.run.nbs_config = v;
       else if (a == "--vision-config")
         cfg.run.vision_config = v;
       else if (a == "--tracker-seed")
