@@ -138,3 +138,32 @@ TEST(StampOrderedBuffer, HoldsUntilLatencyAndBoundsMemory) {
   EXPECT_EQ(b.forcedReleases(), 2u);
   EXPECT_EQ(b.size(), 3u);
 }
+
+#include <cstdio>
+#include <fstream>
+
+#include "picker_localisation/core/yaml_file.h"
+
+TEST(YamlFile, ParsesAndNamesTheFileInEveryError) {
+  char name[] = "yaml_file_testXXXXXX";
+  const int fd = mkstemp(name);
+  ASSERT_GE(fd, 0);
+  const std::string path = name;
+  std::ofstream(path) << "a: 3\n";
+  EXPECT_EQ(parseYamlFile(path, [](const YAML::Node& n) { return n["a"].as<int>(); }), 3);
+  try {  // the parser's own error gets the path in front
+    parseYamlFile(path, [](const YAML::Node&) -> int { throw std::runtime_error("bad key 'a'"); });
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": bad key 'a'");
+  }
+  std::ofstream(path) << "a: [\n";  // YAML syntax error
+  try {
+    parseYamlFile(path, [](const YAML::Node&) { return 0; });
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(path + ": ", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(parseYamlFile(path + ".missing", [](const YAML::Node&) { return 0; }), std::runtime_error);
+  std::remove(path.c_str());
+}

@@ -1,5 +1,7 @@
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
+#include "picker_localisation/core/yaml_file.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -208,17 +210,9 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node) {
 }
 
 PlannerConfig PlannerConfig::fromYamlFile(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  try {
+  return core::parseYamlFile(path, [](const YAML::Node& root) {
     return fromYaml(root["nbs_planner"] ? root["nbs_planner"] : root);
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
+  });
 }
 
 NextBestSensePlanner::NextBestSensePlanner(std::shared_ptr<const TopologicalMap> map, PlannerConfig config)

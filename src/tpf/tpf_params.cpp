@@ -1,5 +1,7 @@
 #include "picker_localisation/tpf/tpf_params.h"
 
+#include "picker_localisation/core/yaml_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -168,17 +170,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
 }
 
 TpfParams TpfParams::fromYamlFile(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  try {
-    return fromYaml(root);
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
+  return core::parseYamlFile(path, [](const YAML::Node& root) { return fromYaml(root); });
 }
 
 std::vector<std::string> TpfParams::methodNames() {
