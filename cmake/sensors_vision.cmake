@@ -9,6 +9,7 @@ add_library(picker_localisation_vision
   src/sensors_vision/munkres.cpp
   src/sensors_vision/cluster_tracker.cpp
   src/sensors_vision/lidar_camera_fusion.cpp
+  src/sensors_vision/leg_pipeline.cpp
   src/sensors_vision/cloud3d_person_detector.cpp
   src/sensors_vision/person_box_detector.cpp)
 target_include_directories(picker_localisation_vision SYSTEM PUBLIC ${OpenCV_INCLUDE_DIRS} ${PCL_INCLUDE_DIRS})

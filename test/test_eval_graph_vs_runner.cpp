@@ -11,8 +11,10 @@
 // measured offline (about 0.1 m and 0.4 nodes on 120 s) but far below what a wrong datum, frame or routing
 // produces (metres, several nodes).
 #include <gtest/gtest.h>
+#include <picker_localisation/Observation.h>
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
@@ -27,6 +29,10 @@ using namespace picker_localisation;
 namespace {
 constexpr double kEuclideanTolerance = 1.0;    // m
 constexpr double kTopologicalTolerance = 2.0;  // nodes
+// LiDAR observations of the graph over the runner's, same simulated span. The leg pipeline is one class in
+// both (sensors::LegPipeline, parity: test_leg_pipeline_parity); a runner that routes or tracks scans
+// differently changes this count by a factor of 2.5 or more (issue 16: one tracker shared by both lasers).
+constexpr double kLidarRatioMin = 0.6, kLidarRatioMax = 1.6;
 }  // namespace
 
 TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
@@ -48,6 +54,11 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
         "/pickers/" + id + "/error", 100,
         [&errors, id](const picker_localisation::TrackingError::ConstPtr& m) { errors[id].push_back(*m); }));
   }
+  std::vector<double> lidar_stamps;
+  subs.push_back(nh.subscribe<picker_localisation::Observation>(
+      "/observations", 1000, [&lidar_stamps](const picker_localisation::Observation::ConstPtr& m) {
+        if (m->sensor == "lidar") lidar_stamps.push_back(m->header.stamp.toSec());
+      }));
   // The evaluator samples at 1 Hz for `duration` s of sim time after the first ground truth, then exits.
   const std::size_t wanted = static_cast<std::size_t>(0.9 * duration);
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(280.0);
@@ -85,10 +96,13 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
   rc.duration = duration;
   ASSERT_EQ(eval::methodUnavailableReason(rc.method, rc), "");
   double off_eu = 0.0, off_topo = 0.0;
+  std::size_t off_lidar = 0;
   const std::uint64_t tracker_seeds[] = {0, 101, 102, 103};
   for (std::uint64_t ts : tracker_seeds) {
     rc.tracker_seed = ts;
-    const eval::RunMetrics m = eval::summariseRun(eval::runOnce(map, rc).samples);
+    const eval::RunResult run = eval::runOnce(map, rc);
+    off_lidar = run.lidar_detections;  // the same for every tracker seed
+    const eval::RunMetrics m = eval::summariseRun(run.samples);
     off_eu += m.euclidean_mean / 4.0;
     off_topo += m.topological_mean / 4.0;
   }
@@ -102,6 +116,23 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
   RecordProperty("offline_topological", std::to_string(off_topo));
   EXPECT_NEAR(graph_eu, off_eu, kEuclideanTolerance);
   EXPECT_NEAR(graph_topo, off_topo, kTopologicalTolerance);
+  // LiDAR observations of the simulated span the runner covers: from the simulation's start (the evaluator's
+  // first sample comes 1 s after the first ground truth) for `duration` s.
+  double first_sample = 1e300;
+  for (const auto& [id, list] : errors)
+    for (const auto& e : list) first_sample = std::min(first_sample, e.header.stamp.toSec());
+  const double sim_start = first_sample - 1.0;
+  std::size_t graph_lidar = 0;
+  for (double t : lidar_stamps) graph_lidar += (t >= sim_start && t <= sim_start + duration) ? 1 : 0;
+  RecordProperty("graph_sim_start", std::to_string(sim_start));
+  RecordProperty("graph_lidar_all", std::to_string(lidar_stamps.size()));
+  std::printf("lidar observations: graph %zu, offline runner %zu\n", graph_lidar, off_lidar);
+  RecordProperty("graph_lidar_observations", std::to_string(graph_lidar));
+  RecordProperty("offline_lidar_observations", std::to_string(off_lidar));
+  ASSERT_GT(off_lidar, 20u);
+  const double ratio = static_cast<double>(graph_lidar) / static_cast<double>(off_lidar);
+  EXPECT_GE(ratio, kLidarRatioMin);
+  EXPECT_LE(ratio, kLidarRatioMax);
 }
 
 int main(int argc, char** argv) {

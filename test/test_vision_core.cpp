@@ -9,6 +9,7 @@
 
 #include "picker_localisation/sensors_vision/cluster_tracker.h"
 #include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/leg_pipeline.h"
 #include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
 #include "picker_localisation/sensors_vision/munkres.h"
 #include "picker_localisation/sensors_vision/person_box_detector.h"
@@ -256,4 +257,31 @@ TEST(Cloud3dPersonDetector, PersonSizedClusterAboveGroundOnly) {
   EXPECT_NEAR(people[0].extent.z(), 1.7, 0.1);
   EXPECT_GT(people[0].confidence, 0.5);
   EXPECT_TRUE(Cloud3dPersonDetector().detect(pcl::PointCloud<pcl::PointXYZ>()).empty());
+}
+
+// The leg pipeline's options schema (shared by the leg_detector node and the offline runner).
+TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
+  using picker_localisation::sensors::LegPipelineOptions;
+  std::vector<std::string> unknown;
+  const LegPipelineOptions o = LegPipelineOptions::fromYaml(
+      YAML::Load("{leg_threshold: 0.3, tentative_misses: 2, position_sigma: 0.2, scan_topics: [a], "
+                 "leg_treshold: 0.5, detections_topic: cam}"),
+      &unknown);
+  EXPECT_DOUBLE_EQ(o.detector.leg_threshold, 0.3);
+  EXPECT_EQ(o.tracker.tentative_misses, 2);
+  EXPECT_DOUBLE_EQ(o.position_sigma, 0.2);
+  EXPECT_TRUE(o.camera_fusion);  // a detections topic enables fusion, as in the node
+  ASSERT_EQ(unknown.size(), 1u);  // scan_topics is a node key: known
+  EXPECT_NE(unknown[0].find("'leg_treshold'"), std::string::npos) << unknown[0];
+  EXPECT_NE(unknown[0].find("'leg_threshold'"), std::string::npos) << unknown[0];
+  for (const char* bad : {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}",
+                          "{hits_to_confirm: 0}", "{leg_threshold: abc}"}) {
+    try {
+      LegPipelineOptions::fromYaml(YAML::Load(bad));
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string key = std::string(bad).substr(1, std::string(bad).find(':') - 1);
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }

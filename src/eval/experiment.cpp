@@ -35,8 +35,7 @@
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #endif
 #ifdef PL_HAVE_VISION
-#include "picker_localisation/sensors_vision/cluster_tracker.h"
-#include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/leg_pipeline.h"
 #endif
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
 #include "picker_localisation/nbs/next_best_sense_planner.h"
@@ -125,6 +124,27 @@ std::string resolveConfigFile(const std::string& value, const std::string& packa
   const std::string p = std::string(PL_EVAL_PACKAGE_DIR) + "/config/" + package_file;
   return fs::exists(p) ? p : "";
 }
+
+// The leg_detector node's options from the `leg_detector:` section of config/vision.yaml and, as demo.launch
+// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.3: the
+// classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files override earlier ones.
+std::vector<std::string> visionConfigFiles(const std::string& value) {
+  std::vector<std::string> files;
+  if (value == "none") return files;
+  if (value.empty()) {
+    for (const char* f : {"vision.yaml", "vision_sim.yaml"}) {
+      const std::string p = resolveConfigFile("", f);
+      if (!p.empty()) files.push_back(p);
+    }
+    return files;
+  }
+  std::stringstream ss(value);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) files.push_back(item);
+  return files;
+}
+
 
 const std::vector<std::string>& allMethodNames() {
   static const std::vector<std::string> names = [] {
@@ -253,48 +273,6 @@ sensors::RfidModelOptions rfidOptions(const std::string& file) {
   return o;
 }
 
-#ifdef PL_HAVE_VISION
-// The leg_detector node's options from the `leg_detector:` section of config/vision.yaml and, as demo.launch
-// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.3: the
-// classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files override earlier ones.
-std::vector<std::string> visionConfigFiles(const std::string& value) {
-  std::vector<std::string> files;
-  if (value == "none") return files;
-  if (value.empty()) {
-    for (const char* f : {"vision.yaml", "vision_sim.yaml"}) {
-      const std::string p = resolveConfigFile("", f);
-      if (!p.empty()) files.push_back(p);
-    }
-    return files;
-  }
-  std::stringstream ss(value);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) files.push_back(item);
-  return files;
-}
-
-void visionOptions(const std::string& value, sensors::LegDetectorOptions& lo, sensors::ClusterTrackerOptions& to) {
-  for (const auto& file : visionConfigFiles(value)) {
-    const YAML::Node root = YAML::LoadFile(file);
-    const YAML::Node y = root["leg_detector"];
-    if (!y) continue;
-    readKey(y, "leg_threshold", lo.leg_threshold);
-    readKey(y, "max_leg_range", lo.max_leg_range);
-    readKey(y, "max_pair_distance", lo.max_pair_distance);
-    readKey(y, "single_leg_people", lo.single_leg_people);
-    readKey(y, "jump_distance", lo.segmentation.jump_distance);
-    int min_points = static_cast<int>(lo.segmentation.min_points);
-    readKey(y, "min_cluster_points", min_points);
-    lo.segmentation.min_points = static_cast<std::size_t>(std::max(1, min_points));
-    readKey(y, "gate_distance", to.gate_distance);
-    readKey(y, "hits_to_confirm", to.hits_to_confirm);
-    readKey(y, "misses_to_delete", to.misses_to_delete);
-    readKey(y, "tentative_misses", to.tentative_misses);
-  }
-}
-#endif
-
 sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
   sensors::DatumConfig c;
   c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
@@ -376,16 +354,13 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   sensors::RfidObservationModel rfid_model(
       registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
-  std::unique_ptr<sensors::LegDetector> legs;
-  sensors::LegDetectorOptions leg_options;
-  sensors::ClusterTrackerOptions leg_track_options;
-  if (spec.lidar) visionOptions(config.vision_config, leg_options, leg_track_options);
-  // as the leg_detector node: one tracker over both lasers, map frame
-  sensors::ClusterTracker leg_tracks(leg_track_options);
+  // The leg_detector node's pipeline, from the same files and keys (one per robot: per-laser trackers).
+  std::unique_ptr<sensors::LegPipeline> legs;
   if (spec.lidar) {
     auto classifier = std::make_shared<sensors::LegClassifier>();
     classifier->load(legModelPath(config));
-    legs = std::make_unique<sensors::LegDetector>(classifier, leg_options);
+    legs = std::make_unique<sensors::LegPipeline>(
+        classifier, sensors::LegPipelineOptions::fromYamlFiles(visionConfigFiles(config.vision_config)));
   }
 #endif
 
@@ -498,30 +473,19 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         scan.range_min = s.range_min;
         scan.range_max = s.range_max;
         scan.ranges = s.ranges;
-        const sensors::LegDetection det = legs->detect(scan);
-        std::vector<Eigen::Vector2d> candidates;
-        for (const auto& p : det.people) candidates.push_back(s.sensor_pose.transform(p.position));
-        // leg_detector node (require_confirmed, its default): only people whose cluster track is confirmed
-        // (hit/miss hysteresis) become observations; spurious clusters stay out.
+        // The sensor pose the node gets from tf, here the simulator's (ground truth) laser pose.
+        const Eigen::Isometry3d fixed_from_sensor =
+            Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
+            Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
+        const std::vector<sensors::TrackedPerson> tracked =
+            legs->processScan(s.robot_id + "/" + s.frame, s.stamp, scan, fixed_from_sensor);
         std::vector<Eigen::Vector2d> people;
-        for (const auto& t : leg_tracks.update(s.stamp, candidates))
-          if (t.updated && t.detection >= 0 && (t.confirmed || !config.require_confirmed))
-            people.push_back(candidates[static_cast<std::size_t>(t.detection)]);
+        for (const auto& t : tracked) people.push_back(t.position);
         result.lidar_detections += people.size();
         if (spec.tracker == Tracker::kUkf) {
           ukf.addDetections(s.stamp, people);
         } else {
-          for (const auto& p : people) {
-            core::Observation obs;
-            obs.stamp = s.stamp;
-            obs.sensor = "lidar";
-            obs.robot_id = s.robot_id;
-            obs.identifying = false;
-            obs.position = p;
-            obs.position_covariance = Eigen::Matrix2d::Identity() * config.lidar_sigma * config.lidar_sigma;
-            core::setGaussianLikelihood(obs, *map, p, obs.position_covariance);
-            toTracker(obs);
-          }
+          for (const auto& t : tracked) toTracker(sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id));
         }
 #endif
       }

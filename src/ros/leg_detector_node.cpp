@@ -4,11 +4,13 @@
 #include <picker_localisation/PersonDetectionArray.h>
 #include <ros/package.h>
 #include <Eigen/Geometry>
+#include <optional>
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/ros/detection_markers.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/vision_io.h"
 #include "picker_localisation/sensors_vision/person_box_detector.h"
 
@@ -20,38 +22,25 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("fixed_frame", fixed_frame_, fixed_frame_);
   pnh_.param("robot_id", robot_id_, robot_id_);
   pnh_.param("tf_timeout", tf_timeout_, tf_timeout_);
-  pnh_.param("position_sigma", position_sigma_, position_sigma_);
-  pnh_.param("require_confirmed", require_confirmed_, require_confirmed_);
   pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
-  pnh_.param("cone_half_width", cone_half_width_, cone_half_width_);
 
-  sensors::LegDetectorOptions lo;
-  pnh_.param("leg_threshold", lo.leg_threshold, lo.leg_threshold);
-  pnh_.param("max_leg_range", lo.max_leg_range, lo.max_leg_range);
-  pnh_.param("max_pair_distance", lo.max_pair_distance, lo.max_pair_distance);
-  pnh_.param("single_leg_people", lo.single_leg_people, lo.single_leg_people);
-  pnh_.param("jump_distance", lo.segmentation.jump_distance, lo.segmentation.jump_distance);
-  int min_points = static_cast<int>(lo.segmentation.min_points);
-  pnh_.param("min_cluster_points", min_points, min_points);
-  lo.segmentation.min_points = static_cast<std::size_t>(std::max(1, min_points));
-  auto& to = tracker_options_;
-  pnh_.param("gate_distance", to.gate_distance, to.gate_distance);
-  pnh_.param("hits_to_confirm", to.hits_to_confirm, to.hits_to_confirm);
-  pnh_.param("misses_to_delete", to.misses_to_delete, to.misses_to_delete);
-  pnh_.param("tentative_misses", to.tentative_misses, to.tentative_misses);
-  sensors::LidarCameraFusionOptions fo;
-  pnh_.param("promote_after", fo.promote_after, fo.promote_after);
-  pnh_.param("demote_after", fo.demote_after, fo.demote_after);
-  pnh_.param("camera_weight", fo.camera_weight, fo.camera_weight);
-  fusion_ = sensors::LidarCameraFusion(fo);
-
+  // The pipeline's options: every private parameter through the schema the offline runner uses too.
+  sensors::LegPipelineOptions options;
+  try {
+    std::vector<std::string> unknown;
+    options = sensors::LegPipelineOptions::fromYaml(paramsAsYaml(pnh_), &unknown);
+    for (const auto& u : unknown) ROS_WARN("%s: %s", ros::this_node::getName().c_str(), u.c_str());
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
+    return;
+  }
   const std::string default_model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
   std::string model = pnh_.param("model_file", default_model);
   if (model.empty()) model = default_model;  // config/vision.yaml documents "" as the shipped model
   try {
     auto classifier = std::make_shared<sensors::LegClassifier>();
     classifier->load(model);
-    legs_ = std::make_unique<sensors::LegDetector>(classifier, lo);
+    pipeline_ = std::make_unique<sensors::LegPipeline>(classifier, options);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
     return;
@@ -74,9 +63,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("detections_topic", detections_topic, detections_topic);
   pnh_.param("camera_info_topic", camera_info_topic, camera_info_topic);
   if (!cloud_topic.empty()) subs_.push_back(nh_.subscribe(cloud_topic, 2, &LegDetectorNode::cloudCallback, this));
-  fusion_enabled_ = !detections_topic.empty();
-  pnh_.param("max_fusion_cluster_width", max_fusion_cluster_width_, max_fusion_cluster_width_);
-  if (fusion_enabled_)
+  if (!detections_topic.empty())
     subs_.push_back(nh_.subscribe(detections_topic, 5, &LegDetectorNode::detectionsCallback, this));
   if (!camera_info_topic.empty())
     subs_.push_back(nh_.subscribe(camera_info_topic, 1, &LegDetectorNode::cameraInfoCallback, this));
@@ -121,28 +108,7 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   }
   Eigen::Isometry3d tf;
   if (!lookup(fixed_frame_, msg->header.frame_id, msg->header.stamp, tf)) return;
-  const auto detection = legs_->detect(scan);
-  std::vector<PersonCandidate> people;
-  for (const auto& p : detection.people) {
-    const Eigen::Vector3d q = tf * Eigen::Vector3d(p.position.x(), p.position.y(), 0.0);
-    people.push_back({q.head<2>(), p.confidence, "lidar", true});
-  }
-  if (fusion_enabled_) {
-    // Every other cluster of person size is a fusion candidate too: a camera cone may promote it.
-    std::vector<char> used(detection.clusters.size(), 0);
-    for (const auto& p : detection.people) {
-      if (p.leg_a >= 0) used[detection.legs[p.leg_a].cluster_index] = 1;
-      if (p.leg_b >= 0) used[detection.legs[p.leg_b].cluster_index] = 1;
-    }
-    for (std::size_t i = 0; i < detection.clusters.size(); ++i) {
-      const auto& c = detection.clusters[i];
-      if (used[i] || (c.points.back() - c.points.front()).norm() > max_fusion_cluster_width_) continue;
-      const Eigen::Vector2d m = c.centroid();
-      const Eigen::Vector3d q = tf * Eigen::Vector3d(m.x(), m.y(), 0.0);
-      people.push_back({q.head<2>(), 0.0, "lidar", false});
-    }
-  }
-  publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
+  publishPeople(msg->header.frame_id, msg->header.stamp, pipeline_->scanCandidates(scan, tf));
 }
 
 void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
@@ -161,7 +127,7 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
   // gate stays relative to the sensor) before the ground removal, then translate the people.
   const Eigen::Matrix3f rotation = tf.linear().cast<float>();
   for (auto& p : cloud.points) p.getVector3fMap() = rotation * p.getVector3fMap();
-  std::vector<PersonCandidate> people;
+  std::vector<sensors::PersonCandidate> people;
   for (const auto& p : cloud_detector_.detect(cloud))
     people.push_back({(p.centroid + tf.translation()).head<2>(), p.confidence, "lidar3d", true});
   publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
@@ -175,89 +141,49 @@ void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetec
 void LegDetectorNode::cameraInfoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg) { camera_info_ = msg; }
 
 void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::Time& stamp,
-                                    std::vector<PersonCandidate> people) {
-  std::vector<Eigen::Vector2d> positions;
-  for (const auto& p : people) positions.push_back(p.position);
-  auto tracker = trackers_.find(source_frame);
-  if (tracker == trackers_.end()) {
-    auto o = tracker_options_;
-    o.first_id = static_cast<int>(trackers_.size()) * 1000000;
-    tracker = trackers_.emplace(source_frame, sensors::ClusterTracker(o)).first;
-  }
-  const auto& tracks = tracker->second.update(stamp.toSec(), positions);
-  std::vector<int> track_of(people.size(), -1);
-  std::vector<bool> confirmed(people.size(), false);
-  for (const auto& t : tracks)
-    if (t.updated && t.detection >= 0) {
-      track_of[t.detection] = t.id;
-      confirmed[t.detection] = t.confirmed;
-    }
-
-  // Camera fusion (Algorithm 4): the candidates in the camera's horizontal frame, one cone per box.
-  std::vector<sensors::FusedPerson> fused;
-  bool camera_frame = false;
+                                    const std::vector<sensors::PersonCandidate>& people) {
+  // The newest camera frame within fusion_max_age, each used once (Algorithm 4 cones).
+  std::optional<sensors::CameraCones> camera;
   if (last_detections_ && std::abs((last_detections_->header.stamp - stamp).toSec()) <= fusion_max_age_) {
     Eigen::Isometry3d cam;
     if (lookup(last_detections_->header.frame_id, fixed_frame_, last_detections_->header.stamp, cam)) {
-      std::vector<sensors::FusionCandidate> candidates;
-      for (std::size_t i = 0; i < people.size(); ++i) {
-        const Eigen::Vector3d q = cam * Eigen::Vector3d(people[i].position.x(), people[i].position.y(), 0.0);
-        candidates.push_back({q.head<2>(), track_of[i], people[i].confidence});
-      }
-      std::vector<sensors::BearingCone> cones;
+      camera.emplace();
+      camera->camera_from_fixed = cam;
       for (const auto& d : last_detections_->detections) {
-        sensors::BearingCone cone{d.bearing, cone_half_width_, d.confidence};
+        sensors::BearingCone cone{d.bearing, pipeline_->options().cone_half_width, d.confidence};
         if (camera_info_ && camera_info_->K[0] > 0.0 && d.box.width > 0) {
           // Sec. 3.4.2: the box's min and max x columns bound the cone.
-          const sensors::CameraIntrinsics k{camera_info_->K[0], camera_info_->K[2], static_cast<int>(camera_info_->width)};
+          const sensors::CameraIntrinsics k{camera_info_->K[0], camera_info_->K[2],
+                                            static_cast<int>(camera_info_->width)};
           const double left = sensors::bearingFromColumn(d.box.x_offset, k);
           const double right = sensors::bearingFromColumn(d.box.x_offset + d.box.width, k);
           cone.half_width = 0.5 * std::abs(left - right);
         }
-        cones.push_back(cone);
+        camera->cones.push_back(cone);
       }
-      camera_frame = true;
-      fused = fusion_.fuse(candidates, cones, true);
-      last_detections_.reset();  // each camera frame is used once
+      last_detections_.reset();
     }
   }
-  if (!camera_frame) {
-    std::vector<sensors::FusionCandidate> candidates;
-    for (std::size_t i = 0; i < people.size(); ++i) candidates.push_back({people[i].position, track_of[i], people[i].confidence});
-    fused = fusion_.fuse(candidates, {}, false);
-  }
+  const std::vector<sensors::TrackedPerson> tracked =
+      pipeline_->track(source_frame, stamp.toSec(), people, camera ? &*camera : nullptr);
 
   picker_localisation::PersonDetectionArray out;
   out.header.stamp = stamp;
   out.header.frame_id = fixed_frame_;
   out.robot_id = robot_id_;
-  const double var = position_sigma_ * position_sigma_;
-  for (std::size_t i = 0; i < people.size(); ++i) {
-    const bool camera = fused[i].camera_confirmed;
-    if (!people[i].classified && !camera) continue;                   // plain cluster, not selected by a cone
-    if (require_confirmed_ && !confirmed[i] && !camera) continue;  // hysteresis: spurious clusters stay out
+  for (const auto& t : tracked) {
     picker_localisation::PersonDetection d;
-    d.position.x = people[i].position.x();
-    d.position.y = people[i].position.y();
+    d.position.x = t.position.x();
+    d.position.y = t.position.y();
+    const double var = pipeline_->options().position_sigma * pipeline_->options().position_sigma;
     d.covariance[0] = d.covariance[4] = var;
-    d.sensor = camera ? (people[i].sensor == "lidar3d" ? "lidar3d_camera" : "lidar_camera") : people[i].sensor;
-    d.confidence = fused[i].confidence;
-    d.track_id = track_of[i];
-    fused_ += camera ? 1 : 0;
+    d.sensor = t.sensor;
+    d.confidence = t.confidence;
+    d.track_id = t.track_id;
+    fused_ += t.camera_confirmed ? 1 : 0;
     out.detections.push_back(d);
     if (map_) {
-      core::Observation obs;
-      obs.stamp = stamp.toSec();
-      // The TPF selects its gamma by sensor kind; a camera-confirmed cluster is still a LiDAR position.
-      obs.sensor = "lidar";
-      obs.robot_id = robot_id_;
-      obs.identifying = false;
-      obs.position = people[i].position;
-      // Camera-confirmed people are weighted higher: a tighter position covariance.
-      const double v = camera ? var * 0.5 : var;
-      obs.position_covariance = Eigen::Matrix2d::Identity() * v;
-      core::setGaussianLikelihood(obs, *map_, people[i].position, obs.position_covariance);
-      obs_pub_.publish(toMsg(obs, *map_, fixed_frame_));
+      obs_pub_.publish(toMsg(sensors::LegPipeline::observation(t, *map_, stamp.toSec(), robot_id_), *map_, fixed_frame_));
       ++observations_;
     }
   }
@@ -281,9 +207,7 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("people published", people_);
   stat.add("camera-confirmed people", fused_);
   stat.add("observations published", observations_);
-  std::size_t live = 0;
-  for (const auto& t : trackers_) live += t.second.tracks().size();
-  stat.add("live tracks", live);
+  stat.add("live tracks", pipeline_ ? pipeline_->liveTracks() : 0);
   stat.add("last input stamp", last_input_.toSec());
 }
 

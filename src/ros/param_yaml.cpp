@@ -40,5 +40,13 @@ YAML::Node toYaml(const XmlRpc::XmlRpcValue& value) {
   return convert(copy);
 }
 
+YAML::Node paramsAsYaml(const ros::NodeHandle& nh) {
+  YAML::Node merged(YAML::NodeType::Map);
+  XmlRpc::XmlRpcValue all;
+  if (nh.getParam("", all) && all.getType() == XmlRpc::XmlRpcValue::TypeStruct)
+    for (auto it = all.begin(); it != all.end(); ++it) merged[it->first] = toYaml(it->second);
+  return merged;
+}
+
 }  // namespace ros_adapter
 }  // namespace picker_localisation

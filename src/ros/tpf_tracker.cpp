@@ -42,10 +42,7 @@ tpf::TpfParams tpfParamsFromRos(const ros::NodeHandle& pnh) {
     }
     if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);
   }
-  XmlRpc::XmlRpcValue all;
-  if (pnh.getParam("", all) && all.getType() == XmlRpc::XmlRpcValue::TypeStruct) {
-    for (auto it = all.begin(); it != all.end(); ++it) merged[it->first] = toYaml(it->second);
-  }
+  for (const auto& kv : paramsAsYaml(pnh)) merged[kv.first.as<std::string>()] = kv.second;
   return tpf::TpfParams::fromYaml(merged);
 }
 

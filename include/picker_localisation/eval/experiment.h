@@ -44,9 +44,6 @@ struct RunConfig {
   double duration = 600.0;        // simulated s (one tour of the Riseholme lanes at 0.5 m/s)
   double sample_period = 1.0;     // s between metric samples (per picker)
   double step = 0.1;              // s, simulator advance between event merges
-  double lidar_sigma = 0.3;       // m, std of the Gaussian node likelihood of a leg detection (leg_detector
-                                  // node ~position_sigma)
-  bool require_confirmed = true;  // leg_detector node ~require_confirmed: only confirmed cluster tracks
   double replan_period = 10.0;    // s, navigation policies re-plan at least this often
   // Configuration files shared with the ROS graph (farm_sim, gnss_ingest, tpf_tracker, ...), so the runner
   // and demo.launch simulate the same farm. "" = the package's config/<file> when it exists, else built-in
@@ -59,7 +56,7 @@ struct RunConfig {
   std::string gnss_config;         // GnssIngest options, config/gnss_ingest.yaml
   std::string rfid_config;         // RfidObservationModel options, config/rfid_ranging.yaml
   std::string nbs_config;          // planner of estimated_node / nbs, config/nbs.yaml
-  std::string vision_config;       // leg_detector section (LegDetector + ClusterTracker options): "" =
+  std::string vision_config;       // leg_detector section (sensors::LegPipelineOptions, as the node): "" =
                                   // config/vision.yaml, then the simulated-laser overlay config/vision_sim.yaml
                                   // (leg_threshold 0.3); else comma-separated files applied in order
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
@@ -67,6 +64,9 @@ struct RunConfig {
 
 // The file a RunConfig field resolves to ("" = built-in defaults): see RunConfig.
 std::string resolveConfigFile(const std::string& value, const std::string& package_file);
+// The files whose `leg_detector:` sections the runner's LegPipeline loads, in order, for a RunConfig
+// vision_config value ("" = config/vision.yaml then config/vision_sim.yaml; "none" = none; else a comma list).
+std::vector<std::string> visionConfigFiles(const std::string& value);
 
 // "" when `method` can run in this build, else one line saying what is missing.
 std::string methodUnavailableReason(const std::string& method, const RunConfig& config = RunConfig());

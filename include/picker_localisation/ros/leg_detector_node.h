@@ -18,9 +18,7 @@
 #include <vector>
 
 #include "picker_localisation/sensors_vision/cloud3d_person_detector.h"
-#include "picker_localisation/sensors_vision/cluster_tracker.h"
-#include "picker_localisation/sensors_vision/leg_detector.h"
-#include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
+#include "picker_localisation/sensors_vision/leg_pipeline.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
@@ -32,13 +30,6 @@ class LegDetectorNode {
   bool ok() const { return ok_; }
 
  private:
-  struct PersonCandidate {
-    Eigen::Vector2d position;  // fixed frame
-    double confidence;
-    std::string sensor;
-    bool classified = true;  // false: a cluster not classified as a person, published only when a camera cone
-                             // selects it (Algorithm 4 promotes the nearest cluster in the cone)
-  };
   void scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg);
   void cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg);
   void detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg);
@@ -46,22 +37,17 @@ class LegDetectorNode {
   bool lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
               Eigen::Isometry3d& out);
   // Tracks, fuses and publishes the people of one scan / cloud (positions in the fixed frame).
-  void publishPeople(const std::string& source_frame, const ros::Time& stamp, std::vector<PersonCandidate> people);
+  void publishPeople(const std::string& source_frame, const ros::Time& stamp,
+                     const std::vector<sensors::PersonCandidate>& people);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
   std::string fixed_frame_ = "map", robot_id_;
-  double tf_timeout_ = 0.1, position_sigma_ = 0.3, fusion_max_age_ = 0.5, cone_half_width_ = 0.1;
-  bool require_confirmed_ = true, fusion_enabled_ = false;
-  double max_fusion_cluster_width_ = 0.8;
-  std::unique_ptr<sensors::LegDetector> legs_;
+  double tf_timeout_ = 0.1, fusion_max_age_ = 0.5;
+  // Detector, per-sensor-frame trackers and camera fusion: the same core pipeline the offline runner uses.
+  std::unique_ptr<sensors::LegPipeline> pipeline_;
   sensors::Cloud3dPersonDetector cloud_detector_;
-  // One tracker per sensor frame: each laser sees only its own field of view, so a person outside it must not
-  // count as a miss of the other laser's track. Ids are kept disjoint (first_id = k * 1000000).
-  sensors::ClusterTrackerOptions tracker_options_;
-  std::map<std::string, sensors::ClusterTracker> trackers_;
-  sensors::LidarCameraFusion fusion_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

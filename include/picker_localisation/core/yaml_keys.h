@@ -1,0 +1,21 @@
+// Checking the keys of an options YAML map: unknown keys are reported with the closest known one, so a typo
+// (`num_particle`) is named instead of silently ignored. ROS-free.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+#include <vector>
+
+namespace picker_localisation {
+namespace core {
+
+// The known key closest to `key` by edit distance ("" when `known` is empty).
+std::string closestKey(const std::string& key, const std::vector<std::string>& known);
+// One message per key of the map `node` that is not in `known`: "<component>: unknown key 'x' (did you mean
+// 'y'?)". A node that is not a map gives none.
+std::vector<std::string> unknownKeys(const YAML::Node& node, const std::vector<std::string>& known,
+                                     const std::string& component);
+
+}  // namespace core
+}  // namespace picker_localisation

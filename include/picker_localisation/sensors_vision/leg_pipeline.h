@@ -1,0 +1,113 @@
+// The LiDAR people pipeline of one robot, as the leg_detector node runs it and as the offline runner
+// (`experiment`) runs it: scan -> clusters (seed 003 Alg. 3) -> leg classifier -> people -> one cluster
+// tracker PER SENSOR FRAME (Alg. 1 hysteresis; a laser that cannot see a person must not count a miss of the
+// other laser's track) -> optional camera fusion (Alg. 4) -> people -> non-identifying Observations.
+// ROS-free: the caller resolves the sensor pose (tf in the node, the simulated mount in the runner) and the
+// camera cones.
+//
+// Options are the `leg_detector:` keys of config/vision.yaml (flat, the node's private parameters); the node
+// and the runner both load them through LegPipelineOptions::fromYaml.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Geometry>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/sensors_vision/cluster_tracker.h"
+#include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
+
+namespace picker_localisation {
+namespace sensors {
+
+struct LegPipelineOptions {
+  LegDetectorOptions detector;
+  ClusterTrackerOptions tracker;
+  LidarCameraFusionOptions fusion;
+  double position_sigma = 0.3;    // m, std of a person's position (observation covariance)
+  bool require_confirmed = true;  // only people on confirmed tracks (or camera-confirmed) are output
+  bool camera_fusion = false;  // unclassified clusters become fusion candidates (node: detections_topic set)
+  double max_fusion_cluster_width =
+      0.8;                       // m, unclassified clusters up to this width may be promoted by a cone
+  double cone_half_width = 0.1;  // rad, half width of a cone when the box edges are unknown
+
+  // Reads the flat keys of config/vision.yaml's `leg_detector:` section (missing keys keep the defaults).
+  // Keys that only concern the node (topics, frames, timeouts) are accepted and ignored. `unknown`, when
+  // given, receives one message per key that is neither (naming the closest known key). Throws
+  // std::runtime_error naming the key on a bad value (type or range, see validate()).
+  static LegPipelineOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  // Applies the `leg_detector:` section of each file in order over `base` (later files win).
+  static LegPipelineOptions fromYamlFiles(const std::vector<std::string>& files,
+                                          std::vector<std::string>* unknown = nullptr);
+  // Empty when valid, else the first problem: "<key> = <value>: must be ...".
+  std::string validate() const;
+};
+
+// A candidate person of one scan or cloud, in the fixed frame.
+struct PersonCandidate {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  double confidence = 0.0;
+  std::string sensor = "lidar";
+  bool classified = true;  // false: a person-sized cluster not classified as a person; output only when a
+                           // camera cone selects it (Algorithm 4 promotes the nearest cluster in the cone)
+};
+
+// The camera frame to fuse with: cones in the camera's horizontal frame and that frame's pose.
+struct CameraCones {
+  Eigen::Isometry3d camera_from_fixed = Eigen::Isometry3d::Identity();
+  std::vector<BearingCone> cones;
+};
+
+// A person the pipeline outputs (fixed frame).
+struct TrackedPerson {
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  double variance = 0.09;        // m^2 per axis (camera-confirmed: half)
+  std::string sensor = "lidar";  // lidar, lidar3d, lidar_camera, lidar3d_camera
+  double confidence = 0.0;
+  int track_id = -1;
+  bool camera_confirmed = false;
+};
+
+class LegPipeline {
+ public:
+  LegPipeline(std::shared_ptr<const LegClassifier> classifier, LegPipelineOptions options);
+  const LegPipelineOptions& options() const { return options_; }
+
+  // Candidates of one laser scan: people of the leg detector and, with camera_fusion, every other cluster of
+  // person size; `fixed_from_sensor` maps the scan frame into the fixed frame.
+  std::vector<PersonCandidate> scanCandidates(const LaserScanData& scan,
+                                              const Eigen::Isometry3d& fixed_from_sensor) const;
+  // Tracks (in `source_frame`'s own tracker), fuses and filters one scan's / cloud's candidates.
+  std::vector<TrackedPerson> track(const std::string& source_frame, double stamp,
+                                   const std::vector<PersonCandidate>& candidates,
+                                   const CameraCones* camera = nullptr);
+  std::vector<TrackedPerson> processScan(const std::string& source_frame, double stamp,
+                                         const LaserScanData& scan,
+                                         const Eigen::Isometry3d& fixed_from_sensor,
+                                         const CameraCones* camera = nullptr) {
+    return track(source_frame, stamp, scanCandidates(scan, fixed_from_sensor), camera);
+  }
+  // The non-identifying Observation of one output person (sensor "lidar": the TPF picks its gamma by kind; a
+  // camera-confirmed cluster is still a LiDAR position, with a tighter covariance).
+  static core::Observation observation(const TrackedPerson& person, const topology::TopologicalMap& map,
+                                       double stamp, const std::string& robot_id);
+
+  std::size_t liveTracks() const;
+  std::size_t cameraConfirmed() const { return camera_confirmed_; }
+
+ private:
+  LegPipelineOptions options_;
+  LegDetector detector_;
+  std::map<std::string, ClusterTracker> trackers_;
+  LidarCameraFusion fusion_;
+  std::size_t camera_confirmed_ = 0;
+};
+
+}  // namespace sensors
+}  // namespace picker_localisation
