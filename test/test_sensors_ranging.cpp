@@ -745,3 +745,24 @@ TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
   EXPECT_LT(mean_err[1], 0.2);
   EXPECT_LT(mean_tan[1], 0.75 * mean_tan[0]);  // measured: 0.036 -> 0.022 rad (-38 %)
 }
+
+// The front-end options schemas shared by the nodes and the offline runner.
+TEST(FrontEndOptions, GnssAndRfidFromYaml) {
+  using picker_localisation::sensors::GnssIngestOptions;
+  using picker_localisation::sensors::RfidModelOptions;
+  std::vector<std::string> unknown;
+  const GnssIngestOptions g =
+      GnssIngestOptions::fromYaml(YAML::Load("{min_sigma: 2.0, velocity_window: 4, datum_file: x, min_sigm: 1}"), &unknown);
+  EXPECT_DOUBLE_EQ(g.min_sigma, 2.0);
+  EXPECT_EQ(g.velocity_window, 4u);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_NE(unknown[0].find("did you mean 'min_sigma'"), std::string::npos) << unknown[0];
+  EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{min_sigma: -1}")), std::runtime_error);
+  EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{velocity_window: -2}")), std::runtime_error);
+  EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{max_speed: fast}")), std::runtime_error);
+  unknown.clear();
+  const RfidModelOptions r = RfidModelOptions::fromYaml(YAML::Load("{d50: 3.0, rfid_topics: [rfid], pdetect: 1}"), &unknown);
+  EXPECT_DOUBLE_EQ(r.d50, 3.0);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_NE(unknown[0].find("'p_detect'"), std::string::npos) << unknown[0];
+}

@@ -16,6 +16,7 @@
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/core/yaml_keys.h"
 #include "picker_localisation/eval/ukf_metric_tracker.h"
 #include "picker_localisation/topology/map_io.h"
 
@@ -228,49 +229,12 @@ sensors::GnssFix toIngestFix(const sim::GnssFix& f) {
   return g;
 }
 
-// The front-end options the ROS nodes load from config/gnss_ingest.yaml and config/rfid_ranging.yaml (keys
-// that only concern the node, such as topics and timeouts, are skipped).
-template <typename T>
-void readKey(const YAML::Node& y, const char* key, T& value) {
-  if (y[key]) value = y[key].as<T>();
-}
-
+// The front-ends' options: the same files and the same schema as the gnss_ingest / rfid_ranging nodes.
 sensors::GnssIngestOptions gnssOptions(const std::string& file) {
-  sensors::GnssIngestOptions o;
-  if (file.empty()) return o;
-  const YAML::Node y = YAML::LoadFile(file);
-  readKey(y, "default_sigma", o.default_sigma);
-  readKey(y, "min_sigma", o.min_sigma);
-  readKey(y, "cutoff_sigmas", o.cutoff_sigmas);
-  readKey(y, "max_nodes", o.max_nodes);
-  readKey(y, "velocity_window", o.velocity_window);
-  readKey(y, "max_speed", o.max_speed);
-  readKey(y, "jump_gate_sigmas", o.jump_gate_sigmas);
-  readKey(y, "jump_reset_count", o.jump_reset_count);
-  readKey(y, "blackout_timeout", o.blackout_timeout);
-  return o;
+  return file.empty() ? sensors::GnssIngestOptions() : sensors::GnssIngestOptions::fromYamlFile(file);
 }
-
 sensors::RfidModelOptions rfidOptions(const std::string& file) {
-  sensors::RfidModelOptions o;
-  if (file.empty()) return o;
-  const YAML::Node y = YAML::LoadFile(file);
-  readKey(y, "read_model", o.read_model);
-  readKey(y, "p_max", o.p_max);
-  readKey(y, "d50", o.d50);
-  readKey(y, "width", o.width);
-  readKey(y, "max_range", o.max_range);
-  readKey(y, "height_difference", o.height_difference);
-  readKey(y, "min_relative", o.min_relative);
-  readKey(y, "read_range", o.read_range);
-  readKey(y, "beam_half_angle", o.beam_half_angle);
-  readKey(y, "min_rssi", o.min_rssi);
-  readKey(y, "out_of_order_tolerance", o.out_of_order_tolerance);
-  readKey(y, "negative_information", o.negative_information);
-  readKey(y, "negative_window", o.negative_window);
-  readKey(y, "negative_period", o.negative_period);
-  readKey(y, "p_detect", o.p_detect);
-  return o;
+  return file.empty() ? sensors::RfidModelOptions() : sensors::RfidModelOptions::fromYamlFile(file);
 }
 
 sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
@@ -406,9 +370,9 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     std::uint64_t what_if_seed = 1;
     if (!nbs_file.empty()) {
       const YAML::Node y = YAML::LoadFile(nbs_file);
-      readKey(y, "planning_period", replan_period);
-      readKey(y, "battery_level", battery_level);
-      readKey(y, "what_if_seed", what_if_seed);
+      core::readOption(y, nbs_file, "planning_period", replan_period);
+      core::readOption(y, nbs_file, "battery_level", battery_level);
+      core::readOption(y, nbs_file, "what_if_seed", what_if_seed);
     }
     pc.policy = spec.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
     planner = std::make_unique<nbs::NextBestSensePlanner>(map, pc);

@@ -3,6 +3,7 @@
 
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/ranging_nodes.h"
 
 namespace picker_localisation {
@@ -24,20 +25,16 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     ROS_FATAL("gnss_ingest: %s", e.what());
     return;
   }
+  // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
   sensors::GnssIngestOptions o;
-  int window = static_cast<int>(o.velocity_window), max_nodes = 0, reset = static_cast<int>(o.jump_reset_count);
-  pnh.param("default_sigma", o.default_sigma, o.default_sigma);
-  pnh.param("min_sigma", o.min_sigma, o.min_sigma);
-  pnh.param("cutoff_sigmas", o.cutoff_sigmas, o.cutoff_sigmas);
-  pnh.param("max_nodes", max_nodes, max_nodes);
-  pnh.param("velocity_window", window, window);
-  pnh.param("max_speed", o.max_speed, o.max_speed);
-  pnh.param("jump_gate_sigmas", o.jump_gate_sigmas, o.jump_gate_sigmas);
-  pnh.param("jump_reset_count", reset, reset);
-  pnh.param("blackout_timeout", o.blackout_timeout, o.blackout_timeout);
-  o.max_nodes = static_cast<std::size_t>(std::max(max_nodes, 0));
-  o.velocity_window = static_cast<std::size_t>(std::max(window, 0));
-  o.jump_reset_count = static_cast<std::size_t>(std::max(reset, 0));
+  try {
+    std::vector<std::string> unknown;
+    o = sensors::GnssIngestOptions::fromYaml(paramsAsYaml(pnh), &unknown);
+    for (const auto& u : unknown) ROS_WARN("%s", u.c_str());
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s", e.what());
+    return;
+  }
   pnh.param<std::string>("frame_id", frame_id_, "map");
   double map_timeout = 30.0;
   pnh.param("map_timeout", map_timeout, map_timeout);

@@ -2,6 +2,7 @@
 
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/ranging_nodes.h"
 
 namespace picker_localisation {
@@ -11,22 +12,16 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "rfid_ranging");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
+  // One options schema, shared with the offline runner (config/rfid_ranging.yaml keys).
   sensors::RfidModelOptions o;
-  pnh.param("read_model", o.read_model, o.read_model);
-  pnh.param("p_max", o.p_max, o.p_max);
-  pnh.param("d50", o.d50, o.d50);
-  pnh.param("width", o.width, o.width);
-  pnh.param("max_range", o.max_range, o.max_range);
-  pnh.param("height_difference", o.height_difference, o.height_difference);
-  pnh.param("min_relative", o.min_relative, o.min_relative);
-  pnh.param("read_range", o.read_range, o.read_range);
-  pnh.param("beam_half_angle", o.beam_half_angle, o.beam_half_angle);
-  pnh.param("min_rssi", o.min_rssi, o.min_rssi);
-  pnh.param("negative_information", o.negative_information, o.negative_information);
-  pnh.param("negative_window", o.negative_window, o.negative_window);
-  pnh.param("negative_period", o.negative_period, o.negative_period);
-  pnh.param("p_detect", o.p_detect, o.p_detect);
-  pnh.param("out_of_order_tolerance", o.out_of_order_tolerance, o.out_of_order_tolerance);
+  try {
+    std::vector<std::string> unknown;
+    o = sensors::RfidModelOptions::fromYaml(paramsAsYaml(pnh), &unknown);
+    for (const auto& u : unknown) ROS_WARN("%s", u.c_str());
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s", e.what());
+    return;
+  }
   pnh.param<std::string>("map_frame", map_frame_, "map");
   pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
   double map_timeout = 30.0;

@@ -1,5 +1,10 @@
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 
+#include <sstream>
+
+#include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
@@ -10,14 +15,73 @@
 namespace picker_localisation {
 namespace sensors {
 
+GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  GnssIngestOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "gnss_ingest";
+  core::readOption(y, c, "default_sigma", o.default_sigma);
+  core::readOption(y, c, "min_sigma", o.min_sigma);
+  core::readOption(y, c, "cutoff_sigmas", o.cutoff_sigmas);
+  core::readOption(y, c, "max_speed", o.max_speed);
+  core::readOption(y, c, "jump_gate_sigmas", o.jump_gate_sigmas);
+  core::readOption(y, c, "blackout_timeout", o.blackout_timeout);
+  auto count = [&](const char* key, std::size_t& value) {
+    long v = static_cast<long>(value);
+    core::readOption(y, c, key, v);
+    if (v < 0) throw std::runtime_error(c + ": " + key + " = " + std::to_string(v) + ": must be >= 0");
+    value = static_cast<std::size_t>(v);
+  };
+  count("max_nodes", o.max_nodes);
+  count("velocity_window", o.velocity_window);
+  count("jump_reset_count", o.jump_reset_count);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  if (unknown) {
+    const std::vector<std::string> known = {
+        "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
+        "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
+        "blackout_timeout", "pickers_file", "datum_file",        "map_file",
+        "map_timeout",      "frame_id",     "observation_topic", "topological_map"};
+    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
+  }
+  return o;
+}
+
+GnssIngestOptions GnssIngestOptions::fromYamlFile(const std::string& path,
+                                                  std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [&](const YAML::Node& root) { return fromYaml(root, unknown); });
+}
+
+std::string GnssIngestOptions::validate() const {
+  auto bad = [](const char* key, double v, const char* rule) {
+    std::ostringstream s;
+    s << key << " = " << v << ": must be " << rule;
+    return s.str();
+  };
+  if (!(default_sigma > 0.0) || !std::isfinite(default_sigma))
+    return bad("default_sigma", default_sigma, "finite and > 0");
+  if (!(min_sigma > 0.0) || !std::isfinite(min_sigma)) return bad("min_sigma", min_sigma, "finite and > 0");
+  if (!(cutoff_sigmas > 0.0)) return bad("cutoff_sigmas", cutoff_sigmas, "> 0");
+  if (!(max_speed > 0.0)) return bad("max_speed", max_speed, "> 0");
+  if (!(jump_gate_sigmas >= 0.0)) return bad("jump_gate_sigmas", jump_gate_sigmas, ">= 0");
+  if (!(blackout_timeout > 0.0)) return bad("blackout_timeout", blackout_timeout, "> 0");
+  return "";
+}
+
 const char* toString(GnssRejection r) {
   switch (r) {
-    case GnssRejection::kNone: return "accepted";
-    case GnssRejection::kNoFix: return "no_fix";
-    case GnssRejection::kNotFinite: return "not_finite";
-    case GnssRejection::kNegativeCovariance: return "negative_covariance";
-    case GnssRejection::kOutOfOrder: return "out_of_order";
-    case GnssRejection::kImpossibleJump: return "impossible_jump";
+    case GnssRejection::kNone:
+      return "accepted";
+    case GnssRejection::kNoFix:
+      return "no_fix";
+    case GnssRejection::kNotFinite:
+      return "not_finite";
+    case GnssRejection::kNegativeCovariance:
+      return "negative_covariance";
+    case GnssRejection::kOutOfOrder:
+      return "out_of_order";
+    case GnssRejection::kImpossibleJump:
+      return "impossible_jump";
   }
   return "unknown";
 }
@@ -77,7 +141,8 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   c_en(1, 1) = std::max(c_en(1, 1), floor);
   const Eigen::Matrix2d c_map = datum_.enuToMap(c_en);
   const Eigen::Vector2d p = datum_.toMap(fix.latitude, fix.longitude, fix.altitude);
-  if (!p.allFinite()) return reject(GnssRejection::kNotFinite, "projection gave NaN/Inf", counters_.not_finite);
+  if (!p.allFinite())
+    return reject(GnssRejection::kNotFinite, "projection gave NaN/Inf", counters_.not_finite);
   result.position = p;
 
   if (last_ && fix.stamp <= last_->stamp) {

@@ -1,5 +1,8 @@
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 
+#include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -8,13 +11,70 @@
 namespace picker_localisation {
 namespace sensors {
 
+RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  RfidModelOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "rfid_ranging";
+  core::readOption(y, c, "read_model", o.read_model);
+  core::readOption(y, c, "p_max", o.p_max);
+  core::readOption(y, c, "d50", o.d50);
+  core::readOption(y, c, "width", o.width);
+  core::readOption(y, c, "max_range", o.max_range);
+  core::readOption(y, c, "height_difference", o.height_difference);
+  core::readOption(y, c, "min_relative", o.min_relative);
+  core::readOption(y, c, "read_range", o.read_range);
+  core::readOption(y, c, "beam_half_angle", o.beam_half_angle);
+  core::readOption(y, c, "min_rssi", o.min_rssi);
+  core::readOption(y, c, "out_of_order_tolerance", o.out_of_order_tolerance);
+  core::readOption(y, c, "negative_information", o.negative_information);
+  core::readOption(y, c, "negative_window", o.negative_window);
+  core::readOption(y, c, "negative_period", o.negative_period);
+  core::readOption(y, c, "p_detect", o.p_detect);
+  if (unknown) {
+    const std::vector<std::string> known = {"read_model",
+                                            "p_max",
+                                            "d50",
+                                            "width",
+                                            "max_range",
+                                            "height_difference",
+                                            "min_relative",
+                                            "read_range",
+                                            "beam_half_angle",
+                                            "min_rssi",
+                                            "out_of_order_tolerance",
+                                            "negative_information",
+                                            "negative_window",
+                                            "negative_period",
+                                            "p_detect",
+                                            "map_frame",
+                                            "observation_topic",
+                                            "rfid_topics",
+                                            "tf_timeout",
+                                            "map_timeout",
+                                            "map_file",
+                                            "pickers_file",
+                                            "topological_map"};
+    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
+  }
+  return o;  // value ranges: checked by RfidObservationModel's constructor (one line naming the key)
+}
+
+RfidModelOptions RfidModelOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [&](const YAML::Node& root) { return fromYaml(root, unknown); });
+}
+
 const char* toString(RfidRejection r) {
   switch (r) {
-    case RfidRejection::kNone: return "accepted";
-    case RfidRejection::kUnknownTag: return "unknown_tag";
-    case RfidRejection::kNotFinite: return "not_finite";
-    case RfidRejection::kWeakSignal: return "weak_signal";
-    case RfidRejection::kOutOfOrder: return "out_of_order";
+    case RfidRejection::kNone:
+      return "accepted";
+    case RfidRejection::kUnknownTag:
+      return "unknown_tag";
+    case RfidRejection::kNotFinite:
+      return "not_finite";
+    case RfidRejection::kWeakSignal:
+      return "weak_signal";
+    case RfidRejection::kOutOfOrder:
+      return "out_of_order";
   }
   return "unknown";
 }
@@ -27,7 +87,8 @@ RfidObservationModel::RfidObservationModel(core::PickerRegistry registry,
   options_.p_detect = std::clamp(options_.p_detect, 0.0, 1.0);
   if (options_.read_model == "disc") {
     logistic_ = false;
-    if (!(options_.read_range > 0.0)) throw std::invalid_argument("RfidObservationModel: read_range must be > 0");
+    if (!(options_.read_range > 0.0))
+      throw std::invalid_argument("RfidObservationModel: read_range must be > 0");
     region_radius_ = options_.read_range;
     position_variance_ = options_.read_range * options_.read_range / 4.0;  // uniform disc: R^2 / 4 per axis
     return;
@@ -44,8 +105,8 @@ RfidObservationModel::RfidObservationModel(core::PickerRegistry registry,
   if (!std::isfinite(options_.d50) || !std::isfinite(options_.height_difference))
     throw std::invalid_argument("RfidObservationModel: d50 and height_difference must be finite");
   // Cut-off: p_read(d) / p_max >= min_relative  <=>  d <= d50 + width ln(1 / min_relative - 1) (3D distance).
-  const double cutoff_3d = std::min(options_.max_range,
-                                    options_.d50 + options_.width * std::log(1.0 / options_.min_relative - 1.0));
+  const double cutoff_3d = std::min(
+      options_.max_range, options_.d50 + options_.width * std::log(1.0 / options_.min_relative - 1.0));
   const double h2 = options_.height_difference * options_.height_difference;
   region_radius_ = cutoff_3d * cutoff_3d > h2 ? std::sqrt(cutoff_3d * cutoff_3d - h2) : 0.0;
   // Position covariance of the read: p_read-weighted second moment over the disc of radius r_c, per axis
@@ -75,7 +136,8 @@ std::vector<topology::NodeIndex> RfidObservationModel::nodesInReadRegion(const E
                                [&](topology::NodeIndex n) {
                                  const Eigen::Vector2d d = map_->position2d(n) - pose.head<2>();
                                  if (d.norm() < 1e-9) return false;  // the antenna's own node
-                                 const double a = std::remainder(std::atan2(d.y(), d.x()) - pose.z(), 2.0 * M_PI);
+                                 const double a =
+                                     std::remainder(std::atan2(d.y(), d.x()) - pose.z(), 2.0 * M_PI);
                                  return std::abs(a) > options_.beam_half_angle;
                                }),
                 nodes.end());
@@ -96,7 +158,8 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
   if (!std::isfinite(read.stamp) || !read.antenna_pose.allFinite())
     return reject(RfidRejection::kNotFinite, "stamp or antenna pose is NaN/Inf", counters_.not_finite);
   const std::optional<std::string> picker = registry_.pickerForRfidTag(read.tag_id);
-  if (!picker) return reject(RfidRejection::kUnknownTag, "unknown tag '" + read.tag_id + "'", counters_.unknown_tag);
+  if (!picker)
+    return reject(RfidRejection::kUnknownTag, "unknown tag '" + read.tag_id + "'", counters_.unknown_tag);
   if (std::isfinite(read.rssi) && read.rssi < options_.min_rssi) {
     std::ostringstream s;
     s << "RSSI " << read.rssi << " dBm below min_rssi " << options_.min_rssi;
@@ -111,7 +174,8 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
   // Reading spell of this antenna (for negative information).
   if (last == antenna_last_stamp_.end() || read.stamp - last->second > options_.negative_window)
     antenna_session_start_[read.antenna_id] = read.stamp;
-  antenna_last_stamp_[read.antenna_id] = std::max(read.stamp, last == antenna_last_stamp_.end() ? read.stamp : last->second);
+  antenna_last_stamp_[read.antenna_id] =
+      std::max(read.stamp, last == antenna_last_stamp_.end() ? read.stamp : last->second);
   last_read_[{read.antenna_id, *picker}] = read.stamp;
   ++counters_.accepted;
 

@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,18 @@ std::string closestKey(const std::string& key, const std::vector<std::string>& k
 // 'y'?)". A node that is not a map gives none.
 std::vector<std::string> unknownKeys(const YAML::Node& node, const std::vector<std::string>& known,
                                      const std::string& component);
+
+// Sets `value` from node[key] when present; a value of the wrong type throws std::runtime_error
+// "<component>: key '<key>' has the wrong type".
+template <typename T>
+void readOption(const YAML::Node& node, const std::string& component, const char* key, T& value) {
+  if (!node[key]) return;
+  try {
+    value = node[key].as<T>();
+  } catch (const YAML::Exception&) {
+    throw std::runtime_error(component + ": key '" + key + "' has the wrong type");
+  }
+}
 
 }  // namespace core
 }  // namespace picker_localisation

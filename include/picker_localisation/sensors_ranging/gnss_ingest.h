@@ -3,6 +3,8 @@
 // experiment runner can feed GnssFix directly.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Core>
 
 #include <array>
@@ -55,6 +57,13 @@ struct GnssIngestOptions {
   double jump_gate_sigmas = 5.0;    // gate in standard deviations (0 disables the gate)
   std::size_t jump_reset_count = 5;
   double blackout_timeout = 10.0;   // s without an accepted fix = blackout (velocity window restarts after it)
+
+  // The keys of config/gnss_ingest.yaml (the gnss_ingest node's private parameters; node-only keys such as
+  // topics are accepted and ignored). Missing keys keep the defaults; a bad value throws std::runtime_error
+  // naming the key; `unknown` receives one message per unknown key (with the closest known one).
+  static GnssIngestOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static GnssIngestOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  std::string validate() const;  // "" or "<key> = <value>: must be ..."
 };
 
 // Result of one fix.

@@ -26,6 +26,8 @@
 // known to be reading (RfidReading has no "inventory round" event), so it gives no negative information.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Core>
 
 #include <map>
@@ -74,6 +76,10 @@ struct RfidModelOptions {
   double negative_period = 5.0;       // s, at most one negative observation per picker and antenna per period
   double p_detect = 0.7;              // probability that a tag inside the read region is read within the window
   double out_of_order_tolerance = 0.0;  // s, reads older than the antenna's newest read by more are rejected
+
+  // The keys of config/rfid_ranging.yaml (node-only keys accepted and ignored), as GnssIngestOptions::fromYaml.
+  static RfidModelOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static RfidModelOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
 };
 
 struct RfidResult {
