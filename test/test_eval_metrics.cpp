@@ -116,6 +116,7 @@ TEST(EvalMetrics, AggregationOverRuns) {
   EXPECT_DOUBLE_EQ(m.topological_mean, 2.0);
   EXPECT_NEAR(m.topological_std, std::sqrt(2.0), 1e-12);
   EXPECT_DOUBLE_EQ(m.right_lane_share, 0.75);
+  EXPECT_NEAR(m.right_lane_share_std, std::sqrt(0.125), 1e-12);  // sample std of {0.5, 1}
   // pooled: eu {1,3,4,4} mean 3, population var (4+0+1+1)/4 = 1.5
   EXPECT_NEAR(m.euclidean_pooled_std, std::sqrt(1.5), 1e-12);
   const MethodSummary one = summariseMethod("y", {runs[0]});
@@ -131,16 +132,18 @@ TEST(EvalReport, SummaryCsvHeaderAndUnavailableRow) {
   a.topological_mean = 3;
   a.topological_std = 1;
   a.right_lane_share = 0.8;
+  a.right_lane_share_std = 0.05;
   const std::string csv = summaryCsv({a, unavailableMethod("nbs", "no nbs library")});
   std::istringstream in(csv);
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line,
-            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
+            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share,"
+            "right_lane_share_std");
   std::getline(in, line);
-  EXPECT_EQ(line, "khan_connected,10,1.5000,0.2500,3.0000,1.0000,0.8000");
+  EXPECT_EQ(line, "khan_connected,10,1.5000,0.2500,3.0000,1.0000,0.8000,0.0500");
   std::getline(in, line);
-  EXPECT_EQ(line, "nbs,0,unavailable,unavailable,unavailable,unavailable,unavailable");
+  EXPECT_EQ(line, "nbs,0,unavailable,unavailable,unavailable,unavailable,unavailable,unavailable");
   const std::string md = summaryMarkdown("t", {a, unavailableMethod("nbs", "no nbs library")});
   EXPECT_NE(md.find("| khan_connected | 10 | 1.50 (0.25)"), std::string::npos);
   EXPECT_NE(md.find("unavailable: no nbs library"), std::string::npos);

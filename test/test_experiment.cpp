@@ -95,7 +95,8 @@ TEST(Experiment, SameSeedSameSummaryAnyJobs) {
   EXPECT_EQ(slurp(dir / "a" / "khan_connected" / "run_1.csv"),
             slurp(dir / "b" / "khan_connected" / "run_1.csv"));
   EXPECT_EQ(s1.substr(0, s1.find('\n')),
-            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share");
+            "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share,"
+            "right_lane_share_std");
   EXPECT_TRUE(fs::exists(dir / "a" / "summary.md"));
   EXPECT_TRUE(fs::exists(dir / "a" / "errors.png"));
   ASSERT_EQ(r1.rows.size(), 3u);

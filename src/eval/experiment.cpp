@@ -559,7 +559,8 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
     log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean
         << " (" << row.euclidean_std << ") m, topological " << row.topological_mean << " ("
-        << row.topological_std << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share
+        << row.topological_std << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share << " ("
+        << row.right_lane_share_std << ")"
         << std::setprecision(1) << "  [" << secs << " s wall]\n"
         << std::defaultfloat;
   }

@@ -102,8 +102,7 @@ MethodSummary summariseMethod(const std::string& method, const std::vector<std::
   double unused = 0.0;
   populationMeanStd(eu_all, unused, m.euclidean_pooled_std);
   populationMeanStd(topo_all, unused, m.topological_pooled_std);
-  double share_sd = 0.0;
-  meanAndStd(shares, m.right_lane_share, share_sd);
+  meanAndStd(shares, m.right_lane_share, m.right_lane_share_std);
   if (shares.empty()) m.right_lane_share = std::numeric_limits<double>::quiet_NaN();
   return m;
 }
@@ -116,7 +115,7 @@ MethodSummary unavailableMethod(const std::string& method, const std::string& re
   const double nan = std::numeric_limits<double>::quiet_NaN();
   m.euclidean_mean = m.euclidean_std = m.euclidean_pooled_std = nan;
   m.topological_mean = m.topological_std = m.topological_pooled_std = nan;
-  m.right_lane_share = nan;
+  m.right_lane_share = m.right_lane_share_std = nan;
   return m;
 }
 

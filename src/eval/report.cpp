@@ -15,7 +15,7 @@ namespace picker_localisation {
 namespace eval {
 
 const char* const kSummaryCsvHeader =
-    "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share";
+    "method,runs,euclidean_mean,euclidean_std,topological_mean,topological_std,right_lane_share,right_lane_share_std";
 
 namespace {
 
@@ -54,11 +54,12 @@ std::string summaryCsv(const std::vector<MethodSummary>& rows) {
   f << kSummaryCsvHeader << '\n';
   for (const auto& r : rows) {
     if (!r.available) {
-      f << r.method << ",0,unavailable,unavailable,unavailable,unavailable,unavailable\n";
+      f << r.method << ",0,unavailable,unavailable,unavailable,unavailable,unavailable,unavailable\n";
       continue;
     }
     f << r.method << ',' << r.runs << ',' << num(r.euclidean_mean) << ',' << num(r.euclidean_std) << ','
-      << num(r.topological_mean) << ',' << num(r.topological_std) << ',' << num(r.right_lane_share) << '\n';
+      << num(r.topological_mean) << ',' << num(r.topological_std) << ',' << num(r.right_lane_share) << ','
+      << num(r.right_lane_share_std) << '\n';
   }
   return f.str();
 }
@@ -73,7 +74,7 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
   std::ostringstream f;
   f << "### " << title << "\n\n";
   f << "| method | runs | Euclidean error [m] mean (std over runs) | pooled std [m] | topological error "
-       "[nodes] mean (std over runs) | pooled std [nodes] | right-lane share |\n";
+       "[nodes] mean (std over runs) | pooled std [nodes] | right-lane share mean (std over runs) |\n";
   f << "|---|---|---|---|---|---|---|\n";
   for (const auto& r : rows) {
     if (!r.available) {
@@ -83,7 +84,8 @@ std::string summaryMarkdown(const std::string& title, const std::vector<MethodSu
     f << "| " << r.method << " | " << r.runs << " | " << num(r.euclidean_mean, 2) << " ("
       << num(r.euclidean_std, 2) << ") | " << num(r.euclidean_pooled_std, 2) << " | "
       << num(r.topological_mean, 2) << " (" << num(r.topological_std, 2) << ") | "
-      << num(r.topological_pooled_std, 2) << " | " << num(r.right_lane_share, 3) << " |\n";
+      << num(r.topological_pooled_std, 2) << " | " << num(r.right_lane_share, 3) << " ("
+      << num(r.right_lane_share_std, 3) << ") |\n";
   }
   return f.str();
 }

@@ -54,7 +54,8 @@ RunMetrics summariseRun(const std::vector<ErrorSample>& samples);
 // *_mean: mean over runs of the per-run means; *_std: sample standard deviation (n-1) of the per-run means
 // over the runs (0 for a single run). *_pooled_std: standard deviation over every sample of every run, which
 // is what the paper's parenthesised numbers most likely are (they often exceed the mean). right_lane_share:
-// mean over the runs that have lane samples (NaN when none does).
+// mean over the runs that have lane samples (NaN when none does), right_lane_share_std the sample std of the
+// per-run shares over those runs.
 struct MethodSummary {
   std::string method;
   std::size_t runs = 0;
@@ -62,7 +63,7 @@ struct MethodSummary {
   std::string unavailable_reason;
   double euclidean_mean = 0.0, euclidean_std = 0.0, euclidean_pooled_std = 0.0;
   double topological_mean = 0.0, topological_std = 0.0, topological_pooled_std = 0.0;
-  double right_lane_share = 0.0;
+  double right_lane_share = 0.0, right_lane_share_std = 0.0;
 };
 
 MethodSummary summariseMethod(const std::string& method, const std::vector<std::vector<ErrorSample>>& runs);
