@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
@@ -67,7 +67,7 @@ TEST(GeodeticDatum, LocalCartesianAgainstEllipsoidRadii) {
   EXPECT_NEAR(pn.x(), 0.0, 0.01);
   EXPECT_NEAR(pn.y(), north, 0.05);  // 111.3 m
   const Eigen::Vector2d pe = datum.toMap(53.268, -0.523);
-  EXPECT_NEAR(pe.x(), east, 0.05);   // 66.8 m
+  EXPECT_NEAR(pe.x(), east, 0.05);  // 66.8 m
   EXPECT_NEAR(pe.y(), 0.0, 0.05);
   // Inverse.
   const Eigen::Vector2d ll = datum.toLatLon(Eigen::Vector2d(120.0, -35.0));
@@ -75,7 +75,7 @@ TEST(GeodeticDatum, LocalCartesianAgainstEllipsoidRadii) {
 }
 
 TEST(GeodeticDatum, HeadingRotatesPositionsAndCovariances) {
-  GeodeticDatum d90(riseholmeDatum(90.0));  // map x points north, map y west
+  GeodeticDatum d90(riseholmeDatum(90.0));              // map x points north, map y west
   const Eigen::Vector2d p = d90.toMap(53.269, -0.524);  // ~111 m north
   EXPECT_NEAR(p.x(), GeodeticDatum(riseholmeDatum()).toMap(53.269, -0.524).y(), 1e-6);
   EXPECT_NEAR(p.y(), 0.0, 0.01);
@@ -107,7 +107,8 @@ TEST(GeodeticDatum, UtmKindKeepsDistancesAndParsesYaml) {
   EXPECT_NEAR(shipped.config().longitude, -0.524, 1e-9);
   // Bad files: one line naming the field.
   EXPECT_THROW(GeodeticDatum::parse("datum: {type: local_cartesian, longitude: 1.0}\n"), std::runtime_error);
-  EXPECT_THROW(GeodeticDatum::parse("datum: {type: mercator, latitude: 1, longitude: 1}\n"), std::runtime_error);
+  EXPECT_THROW(GeodeticDatum::parse("datum: {type: mercator, latitude: 1, longitude: 1}\n"),
+               std::runtime_error);
   EXPECT_THROW(GeodeticDatum::parse("datum: {latitude: 95, longitude: 1}\n"), std::runtime_error);
   EXPECT_THROW(GeodeticDatum::parse("nodatum: 1\n"), std::runtime_error);
 }
@@ -277,7 +278,8 @@ TEST(RfidObservationModel, LogisticReadProbabilityLikelihood) {
   EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 0, -4)), 0.475, 1e-12);
   EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 5, 0)), 0.1836553013, 1e-9);
   EXPECT_NEAR(likelihoodAt(obs, nodeAt(*map, 7, 0)), 0.0128980711, 1e-9);
-  EXPECT_EQ(likelihoodAt(obs, nodeAt(*map, 8, 0)), 0.0);  // p_read(8) / p_max = 0.0033 < min_relative: not listed
+  EXPECT_EQ(likelihoodAt(obs, nodeAt(*map, 8, 0)),
+            0.0);  // p_read(8) / p_max = 0.0033 < min_relative: not listed
   // A 3 m height difference: 3D distance 5 m for a node 4 m away in the plane.
   RfidModelOptions oh = o;
   oh.height_difference = 3.0;
@@ -366,7 +368,7 @@ TEST(RfidObservationModel, LogisticNegativeInformation) {
       ASSERT_EQ(n.nodes.size(), map->numNodes());
       EXPECT_EQ(core::validateObservation(n, *map), "");
       EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 0, 0)), 1.0 - 0.7 * 0.9468767217 / 0.95, 1e-9);  // 0.30230
-      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 4, 0)), 0.65, 1e-12);                           // 1 - 0.7 / 2
+      EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 4, 0)), 0.65, 1e-12);                            // 1 - 0.7 / 2
       EXPECT_NEAR(likelihoodAt(n, nodeAt(*map, 7, 0)), 1.0 - 0.7 * 0.0128980711 / 0.95, 1e-9);  // 0.99050
       EXPECT_EQ(likelihoodAt(n, nodeAt(*map, 8, 0)), 1.0);  // beyond the cut-off
     }
@@ -465,7 +467,8 @@ TEST(RangeHistogramFilter, CameraBearingResolvesASingleRing) {
   EXPECT_LT(e->position.norm(), 0.5);
   EXPECT_GT(e->covariance.trace(), 20.0);  // ring of radius 5: ~ 25 / 2 per axis
   RangeHistogramFilter fused;
-  e = fused.update(0.0, rangesTo({4.0, 3.0}, 0.05, one), {{Eigen::Vector2d::Zero(), std::atan2(3.0, 4.0), 0.03}});
+  e = fused.update(0.0, rangesTo({4.0, 3.0}, 0.05, one),
+                   {{Eigen::Vector2d::Zero(), std::atan2(3.0, 4.0), 0.03}});
   ASSERT_TRUE(e.has_value());
   EXPECT_NEAR(e->position.x(), 4.0, 0.15);
   EXPECT_NEAR(e->position.y(), 3.0, 0.15);
@@ -473,9 +476,11 @@ TEST(RangeHistogramFilter, CameraBearingResolvesASingleRing) {
 
 TEST(RangeHistogramFilter, CameraGateIgnoresBystandersAndUsesTheTarget) {
   // Target at (4, 1.5) (UWB), a bystander at (-3, 2): the bystander's wedge meets only UWB floor cells
-  // (score 0.05 = P_min^uwb < gate 0.1) and is ignored; a wedge at the target passes. With the gate off both are used.
+  // (score 0.05 = P_min^uwb < gate 0.1) and is ignored; a wedge at the target passes. With the gate off both
+  // are used.
   const Eigen::Vector2d target(4.0, 1.5), bystander(-3.0, 2.0);
-  const BearingMeasurement at_bystander{Eigen::Vector2d::Zero(), std::atan2(bystander.y(), bystander.x()), 0.03};
+  const BearingMeasurement at_bystander{Eigen::Vector2d::Zero(), std::atan2(bystander.y(), bystander.x()),
+                                        0.03};
   const BearingMeasurement at_target{Eigen::Vector2d::Zero(), std::atan2(target.y(), target.x()), 0.03};
   RangeHistogramFilter gated;
   auto e = gated.update(0.0, rangesTo(target), {at_bystander});
@@ -544,7 +549,8 @@ TEST(RangeHistogramFilter, BadInputLeavesTheFilterUnchanged) {
   RangeHistogramFilter rhf;
   EXPECT_FALSE(rhf.update(0.0, {}).has_value());
   EXPECT_FALSE(rhf.initialised());
-  EXPECT_FALSE(rhf.update(0.0, {{Eigen::Vector2d::Zero(), kNaN, 0.01}, {Eigen::Vector2d::Zero(), -1.0, 0.01}}).has_value());
+  EXPECT_FALSE(rhf.update(0.0, {{Eigen::Vector2d::Zero(), kNaN, 0.01}, {Eigen::Vector2d::Zero(), -1.0, 0.01}})
+                   .has_value());
   ASSERT_TRUE(rhf.update(1.0, rangesTo({4.0, 1.5})).has_value());
   const std::vector<float> before = rhf.grid();
   EXPECT_FALSE(rhf.update(0.5, rangesTo({-4.0, 1.5})).has_value());  // backwards
@@ -604,8 +610,9 @@ TEST(UwbRanging, BatchesAnchorsIntoOneObservationAndRejectsBadInput) {
   const Eigen::Vector2d person_map(2.0, 2.5), person_robot = person_map - robot.translation();
   std::vector<core::Observation> out;
   for (int a = 0; a < 3; ++a)
-    EXPECT_EQ(uwb.addRange(uwbInput(1.0 + 0.01 * a, "uwb_2", a, (person_robot - kAnchors[a]).norm()), robot, &out),
-              UwbRejection::kNone);
+    EXPECT_EQ(
+        uwb.addRange(uwbInput(1.0 + 0.01 * a, "uwb_2", a, (person_robot - kAnchors[a]).norm()), robot, &out),
+        UwbRejection::kNone);
   EXPECT_TRUE(out.empty());  // batch still open
   uwb.flush(1.05, &out);
   EXPECT_TRUE(out.empty());  // window 0.1 s not over
@@ -654,7 +661,8 @@ TEST(UwbRanging, AmbiguousOrEdgeEstimatesAreNotPublished) {
   UwbRanging uwb(twoPickers(), map);
   std::vector<core::Observation> out;
   // One anchor only: a ring of radius 4 (sd ~ 2.8 m > max_output_sigma 2 m) -> suppressed.
-  ASSERT_EQ(uwb.addRange(uwbInput(1.0, "uwb_1", 0, 4.0), Eigen::Isometry2d::Identity(), &out), UwbRejection::kNone);
+  ASSERT_EQ(uwb.addRange(uwbInput(1.0, "uwb_1", 0, 4.0), Eigen::Isometry2d::Identity(), &out),
+            UwbRejection::kNone);
   uwb.flush(2.0, &out);
   EXPECT_TRUE(out.empty());
   EXPECT_EQ(uwb.counters().suppressed, 1u);
@@ -685,8 +693,8 @@ TEST(UwbRanging, PdoaDirectAndAsBearing) {
   UwbRanging direct(twoPickers(), map, o);
   Eigen::Isometry2d robot = Eigen::Isometry2d::Identity();
   robot.linear() = Eigen::Rotation2Dd(M_PI / 2.0).toRotationMatrix();  // robot faces +y
-  UwbRangeInput in = uwbInput(1.0, "uwb_1", 0, 4.0);                  // anchor at (1, 1) in base_link
-  in.pdoa_angle = 0.0;                                                // straight ahead of the anchor
+  UwbRangeInput in = uwbInput(1.0, "uwb_1", 0, 4.0);                   // anchor at (1, 1) in base_link
+  in.pdoa_angle = 0.0;                                                 // straight ahead of the anchor
   std::vector<core::Observation> out;
   ASSERT_EQ(direct.addRange(in, robot, &out), UwbRejection::kNone);
   ASSERT_EQ(out.size(), 1u);
@@ -724,7 +732,9 @@ TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
       std::vector<RangeMeasurement> ranges;
       for (const auto& a : kAnchors) ranges.push_back({a, (person - a).norm() + range_noise(rng), 0.01});
       std::vector<BearingMeasurement> bearings;
-      if (use_cam) bearings.push_back({Eigen::Vector2d::Zero(), std::atan2(person.y(), person.x()) + bearing_noise(rng), 0.03});
+      if (use_cam)
+        bearings.push_back(
+            {Eigen::Vector2d::Zero(), std::atan2(person.y(), person.x()) + bearing_noise(rng), 0.03});
       auto e = rhf.update(t, ranges, bearings);
       ASSERT_TRUE(e.has_value());
       if (i < 20) continue;  // settle
@@ -737,8 +747,9 @@ TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
     mean_err[use_cam] /= n;
     mean_tan[use_cam] /= n;
   }
-  std::printf("RHF simulated walk: mean error UWB %.3f m (angular %.4f rad), UWB+camera %.3f m (angular %.4f rad)\n",
-              mean_err[0], mean_tan[0], mean_err[1], mean_tan[1]);
+  std::printf(
+      "RHF simulated walk: mean error UWB %.3f m (angular %.4f rad), UWB+camera %.3f m (angular %.4f rad)\n",
+      mean_err[0], mean_tan[0], mean_err[1], mean_tan[1]);
   RecordProperty("mean_error_uwb_m", std::to_string(mean_err[0]));
   RecordProperty("mean_error_uwb_camera_m", std::to_string(mean_err[1]));
   EXPECT_LT(mean_err[0], 0.5);
@@ -751,8 +762,8 @@ TEST(FrontEndOptions, GnssAndRfidFromYaml) {
   using picker_localisation::sensors::GnssIngestOptions;
   using picker_localisation::sensors::RfidModelOptions;
   std::vector<std::string> unknown;
-  const GnssIngestOptions g =
-      GnssIngestOptions::fromYaml(YAML::Load("{min_sigma: 2.0, velocity_window: 4, datum_file: x, min_sigm: 1}"), &unknown);
+  const GnssIngestOptions g = GnssIngestOptions::fromYaml(
+      YAML::Load("{min_sigma: 2.0, velocity_window: 4, datum_file: x, min_sigm: 1}"), &unknown);
   EXPECT_DOUBLE_EQ(g.min_sigma, 2.0);
   EXPECT_EQ(g.velocity_window, 4u);
   ASSERT_EQ(unknown.size(), 1u);
@@ -761,8 +772,43 @@ TEST(FrontEndOptions, GnssAndRfidFromYaml) {
   EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{velocity_window: -2}")), std::runtime_error);
   EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{max_speed: fast}")), std::runtime_error);
   unknown.clear();
-  const RfidModelOptions r = RfidModelOptions::fromYaml(YAML::Load("{d50: 3.0, rfid_topics: [rfid], pdetect: 1}"), &unknown);
+  const RfidModelOptions r =
+      RfidModelOptions::fromYaml(YAML::Load("{d50: 3.0, rfid_topics: [rfid], pdetect: 1}"), &unknown);
   EXPECT_DOUBLE_EQ(r.d50, 3.0);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].find("'p_detect'"), std::string::npos) << unknown[0];
+}
+
+TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
+  // Two reads of one tag by one antenna 2 s apart at attempt_rate 2 Hz: m = round(2 * 2) - 1 = 3 failed
+  // attempts, so the second read's likelihood is p (1 - p)^3 (hand values from p_read(0) and p_read(4)).
+  auto map = latticeMap(10.0, 1.0);
+  RfidModelOptions o;
+  o.negative_information = false;
+  RfidObservationModel rfid(twoPickers(), map, o);
+  RfidRead read;
+  read.stamp = 1.0;
+  read.robot_id = "robot_1";
+  read.antenna_id = "robot_1/rfid_antenna";
+  read.tag_id = "rfid_2";
+  const RfidResult first = rfid.process(read);
+  ASSERT_TRUE(first.accepted());
+  EXPECT_NEAR(likelihoodAt(*first.observation, nodeAt(*map, 0, 0)), 0.9468767217,
+              1e-9);  // first read: p alone
+  read.stamp = 3.0;
+  const RfidResult second = rfid.process(read);
+  ASSERT_TRUE(second.accepted());
+  const double p0 = 0.9468767217, p4 = 0.475;
+  EXPECT_NEAR(likelihoodAt(*second.observation, nodeAt(*map, 0, 0)), p0 * std::pow(1.0 - p0, 3), 1e-9);
+  EXPECT_NEAR(likelihoodAt(*second.observation, nodeAt(*map, 4, 0)), p4 * std::pow(1.0 - p4, 3), 1e-9);
+  // The tag is now more likely 4 m from the antenna than next to it.
+  EXPECT_GT(likelihoodAt(*second.observation, nodeAt(*map, 4, 0)),
+            likelihoodAt(*second.observation, nodeAt(*map, 0, 0)));
+  // attempt_rate 0: reads only (the former model).
+  o.attempt_rate = 0.0;
+  RfidObservationModel plain(twoPickers(), map, o);
+  read.stamp = 1.0;
+  plain.process(read);
+  read.stamp = 3.0;
+  EXPECT_NEAR(likelihoodAt(*plain.process(read).observation, nodeAt(*map, 0, 0)), p0, 1e-9);
 }

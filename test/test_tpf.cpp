@@ -51,8 +51,14 @@ core::Observation obsAt(double stamp, std::vector<NodeIndex> nodes, std::vector<
 }
 
 // A filter whose particles never move by themselves: no velocity, no noise, no unconnected jumps.
+// The paper's filter read literally (the equation and Algorithm 1 tests check the paper's numbers); the
+// product's defaults depart from it (TpfParams, docs/readme/tpf.md) and are tested on their own below.
+TpfParams paperTpf() {
+  return TpfParams::presetForMethod("paper_tpf");
+}
+
 TpfParams staticParams(std::size_t particles = 2000) {
-  TpfParams p;
+  TpfParams p = paperTpf();
   p.num_particles = particles;
   p.velocity_init_variance = 0.0;
   p.velocity_noise_variance = 0.0;
@@ -85,7 +91,7 @@ TEST(TpfEquations, Eq6HalfJumpProbabilityAtHalfEdgeDwell) {
 
 TEST(TpfEquations, Eq2Eq3ProjectionWeightsAndNoJumpAgainstVelocity) {
   auto map = laneMap();
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   const NodeIndex mid = 2;  // neighbours 1 (at -x) and 3 (at +x), undirected motion graph
   ASSERT_EQ(map->neighbours(mid), (std::vector<NodeIndex>{1, 3}));
   // Velocity +x at 0.5 m/s, dwell 3 s on 3 m edges: b = (0, 0.5); jump to 3 with 1 - exp(2 ln(1/2) 0.5/3 * 3)
@@ -110,7 +116,7 @@ TEST(TpfEquations, TurningWhenNoEdgeIsAligned) {
   // Velocity (0.1, 0.7) on an x-lane: largest projection 0.1 < 0.2 |v| = 0.141: both edges get b = |v| and
   // the same Eq. 2 / 6 term; at the lane end (node 4, only neighbour 3 behind) a +x particle turns back.
   auto map = laneMap();
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   const double v = std::hypot(0.1, 0.7), tau = 2.0;
   const double each = 0.5 * (1.0 - std::exp(2.0 * std::log(0.5) * v / 3.0 * tau));
   auto t = f.transitionProbabilities(2, 0.1, 0.7, tau);
@@ -135,7 +141,7 @@ TEST(TpfEquations, Eq2MixesSeveralEdgesByProjection) {
   nodes[2].position = Eigen::Vector3d(0, 4, 0);
   auto map = std::make_shared<const topology::TopologicalMap>(
       topology::TopologicalMap::build("star", nodes, {{"ca", "c", "a", ""}, {"cb", "c", "b", ""}}));
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   const double tau = 2.0;
   const double p1 = 1.0 - std::exp(2.0 * std::log(0.5) * 1.0 / 3.0 * tau);
   const double p2 = 1.0 - std::exp(2.0 * std::log(0.5) * 1.0 / 4.0 * tau);
@@ -147,7 +153,7 @@ TEST(TpfEquations, Eq2MixesSeveralEdgesByProjection) {
 
 TEST(TpfEquations, DirectedMotionFollowsFileEdges) {
   auto map = laneMap();
-  TpfParams p;
+  TpfParams p = paperTpf();
   p.directed_motion = true;
   TopologicalParticleFilter f(map, p, 1);
   // Edges run 0 -> 1 -> ... ; node 2's only motion neighbour is 3: +x jumps, -x turns there (b = |v|).
@@ -226,7 +232,7 @@ TEST(TpfEquations, JumpsDoNotDependOnThePredictionRate) {
 // --------------------------------------------------------------------------------------------- Eq. 8 ------
 TEST(TpfEquations, Eq8WeightPerSensor) {
   auto map = laneMap();
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   Particle p;
   p.node = 1;
   p.vx = 0.5f;
@@ -541,7 +547,7 @@ TEST(TpfAlgorithm1, WrongLaneInitialisationRecoveryByMethod) {
 // ------------------------------------------------------------------------------------------ bad input ------
 TEST(TpfBadInput, RejectedObservationsLeaveTheBeliefUntouched) {
   auto map = polytunnel();
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   // Before initialisation: nothing to predict.
   EXPECT_FALSE(f.predictTo(5.0));
   ASSERT_TRUE(f.update(obsAt(10.0, {10}, {1.0})).ok());
@@ -611,7 +617,7 @@ TEST(TpfBadInput, KhanIgnoresNonGnssSensors) {
 
 TEST(TpfBadInput, ResetForgetsTheBelief) {
   auto map = polytunnel();
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   ASSERT_TRUE(f.update(obsAt(10.0, {10}, {1.0})).ok());
   f.reset();
   EXPECT_FALSE(f.initialised());
@@ -645,6 +651,7 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.prediction_rate, 0.25);
   EXPECT_EQ(p.motion_model, tpf::MotionModel::kVelocity);
   EXPECT_TRUE(p.jsd_monitor);
+  EXPECT_EQ(p.reinit_sensors, (std::vector<std::string>{"gnss", "uwb"}));  // measured default (tpf.md)
   EXPECT_TRUE(p.entropy_gate);
   EXPECT_FALSE(p.directed_motion);
   EXPECT_TRUE(p.accepted_sensors.empty());
@@ -653,6 +660,14 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.num_particles, d.num_particles);
   EXPECT_EQ(p.unconnected_jump_probability, d.unconnected_jump_probability);
   EXPECT_EQ(p.reorder_window, d.reorder_window);
+  EXPECT_EQ(p.velocity_follows_edge, d.velocity_follows_edge);
+  EXPECT_EQ(p.velocity_weight_product, d.velocity_weight_product);
+  EXPECT_EQ(p.reverse_rate, d.reverse_rate);
+  EXPECT_EQ(p.lane_change_model, d.lane_change_model);
+  EXPECT_EQ(p.lane_change_leak, d.lane_change_leak);
+  EXPECT_EQ(p.lane_change_max_hops, d.lane_change_max_hops);
+  EXPECT_EQ(p.jsd_monitor, d.jsd_monitor);
+  EXPECT_EQ(p.reinit_fraction, d.reinit_fraction);
 }
 
 TEST(TpfParamsTest, PresetsAndErrors) {
@@ -714,7 +729,7 @@ void runSequence(TopologicalParticleFilter& f) {
 TEST(TpfDeterminism, SameSeedSameBeliefsBitForBit) {
   auto map = polytunnel();
   for (auto scheme : {tpf::ResamplingScheme::kLowVariance, tpf::ResamplingScheme::kMultinomial}) {
-    TpfParams p;
+    TpfParams p = paperTpf();
     p.resampling = scheme;
     TopologicalParticleFilter a(map, p, 42), b(map, p, 42), c(map, p, 43);
     runSequence(a);
@@ -741,7 +756,7 @@ TEST(TpfDeterminism, SameSeedSameBeliefsBitForBit) {
 
 TEST(TpfWhatIf, LiveFilterUntouched) {
   auto map = polytunnel();
-  TopologicalParticleFilter f(map, TpfParams(), 3);
+  TopologicalParticleFilter f(map, paperTpf(), 3);
   runSequence(f);
   const auto particles = f.particles();
   const auto belief = f.belief();
@@ -776,7 +791,7 @@ TEST(TpfWhatIf, LiveFilterUntouched) {
   EXPECT_EQ(f.belief().stamp, belief.stamp);
   EXPECT_EQ(f.counters().accepted, counters.accepted);
   // The live filter continues as if nothing happened: same as a twin that never answered a what-if.
-  TopologicalParticleFilter twin(map, TpfParams(), 3);
+  TopologicalParticleFilter twin(map, paperTpf(), 3);
   runSequence(twin);
   auto o = obsAt(40.0, {50}, {1.0});
   f.update(o);
@@ -848,7 +863,7 @@ TEST(TpfTracking, SyntheticLaneWithExactGnssWithinOneHop) {
   up.push_back(*map->index("T4"));
   for (bool consistent : {false, true}) {
     for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
-      TpfParams p;
+      TpfParams p = paperTpf();
       p.step_consistent_jumps = consistent;
       TopologicalParticleFilter f(map, p, seed);
       const TrackStats s = trackWalk(f, up, 0.5, 5.0);
@@ -862,7 +877,7 @@ TEST(TpfTracking, SyntheticLaneWithExactGnssWithinOneHop) {
   std::vector<NodeIndex> back = up;
   for (int j = 9; j >= 0; --j) back.push_back(*map->index("r4_" + std::to_string(j)));
   for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
-    TopologicalParticleFilter f(map, TpfParams(), seed);
+    TopologicalParticleFilter f(map, paperTpf(), seed);
     const TrackStats s = trackWalk(f, back, 0.5, 5.0);
     EXPECT_LE(s.max_hops, 2) << "seed " << seed << " at t = " << s.worst_time << " s";
     EXPECT_GE(s.within_one, 0.95) << "seed " << seed;
@@ -891,7 +906,7 @@ TEST(TpfTracking, RiseholmeLaneWithExactGnssWithinOneHop) {
   const auto path = map->shortestPath(a, b);
   ASSERT_GE(path.size(), 5u);
   for (std::uint64_t seed : {1u, 2u, 3u}) {
-    TopologicalParticleFilter f(map, TpfParams(), seed);
+    TopologicalParticleFilter f(map, paperTpf(), seed);
     const TrackStats s = trackWalk(f, path, 0.5, 5.0);
     EXPECT_LE(s.max_hops, 1) << "seed " << seed;
   }
@@ -903,8 +918,72 @@ TEST(TpfTracking, SparseUpdatesOnALargeMap) {
       topology::makePolytunnelMap(topology::polytunnelSpecWithNodes(10000)));
   std::vector<NodeIndex> path;
   for (int j = 0; j < 30; ++j) path.push_back(*map->index("r7_" + std::to_string(j)));
-  TopologicalParticleFilter f(map, TpfParams(), 1);
+  TopologicalParticleFilter f(map, paperTpf(), 1);
   const TrackStats s = trackWalk(f, path, 0.5, 5.0);
   EXPECT_LE(s.max_hops, 1);
   EXPECT_LT(f.belief().nodes.size(), 50u);
+}
+
+// ------------------------------------------------------------------------- product departures from the paper
+// ---
+TEST(TpfLaneChange, ParticlesLeavingALaneEndWalkIntoTheAdjacentLane) {
+  // All particles at the end node of lane 5 walking out of it (-y, towards the headland node H5). With the
+  // lane-change model they follow H5 -> H4 -> r4_0 or H5 -> H6 -> r6_0 into a neighbouring lane; without it
+  // they turn at random on the headland and walk along it (velocity follows the edge taken). 20 s: ~17 m.
+  auto map = polytunnel();
+  const NodeIndex start = *map->index("r5_0");
+  auto shares = [&](bool lane_change) {
+    TpfParams p;  // product defaults
+    p.num_particles = 4000;
+    p.lane_change_model = lane_change;
+    p.reverse_rate = 0.0;
+    p.velocity_init_mean = -0.6;  // v = (-0.6, -0.6): the first jump is to H5, then the heading is -y
+    p.velocity_init_variance = 0.0;
+    p.dwell_init_max = 0.0;
+    p.unconnected_jump_probability = 0.0;
+    TopologicalParticleFilter f(map, p, 11);
+    EXPECT_TRUE(f.update(obsAt(0.0, {start}, {1.0})).ok());
+    for (int k = 1; k <= 20; ++k) f.predictTo(k);  // ~17 m at 0.85 m/s: not yet at the lanes' far ends
+    std::size_t left = 0, adjacent = 0;
+    for (const auto& q : f.particles()) {
+      const auto lane = map->lane(q.node);
+      if (lane == map->lane(start)) continue;
+      ++left;
+      if (lane >= 0 && (map->laneName(lane) == "row_4" || map->laneName(lane) == "row_6")) ++adjacent;
+    }
+    return std::make_pair(static_cast<double>(left) / f.particles().size(),
+                          left ? static_cast<double>(adjacent) / left : 0.0);
+  };
+  const auto with = shares(true), without = shares(false);
+  EXPECT_GT(with.first, 0.3);   // many particles left the lane
+  EXPECT_GT(with.second, 0.8);  // ... and most of them are in lane 4 or 6
+  EXPECT_LT(without.second, with.second - 0.2);
+}
+
+TEST(TpfLaneChange, VelocityFollowsTheEdgeAndParticlesReverse) {
+  auto map = laneMap();
+  TpfParams p = staticParams(2000);
+  p.velocity_follows_edge = true;
+  p.velocity_init_mean = 0.5;
+  p.dwell_init_max = 0.0;
+  TopologicalParticleFilter f(map, p, 7);
+  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
+  ASSERT_TRUE(f.predictTo(3.0));
+  for (const auto& q : f.particles())
+    if (q.node == 3) {
+      EXPECT_NEAR(q.vy, 0.0, 1e-6);  // heading = the edge taken (+x): the y component is gone
+      EXPECT_NEAR(q.vx, std::hypot(0.5, 0.5) + 0.5 * (1.0 - std::hypot(0.5, 0.5)) / 10.0,
+                  1e-4);  // Eq. 7 on the speed
+    }
+  // reverse_rate: about 1 - exp(-rate t) of the particles have turned round.
+  TpfParams r = staticParams(20000);
+  r.reverse_rate = 0.05;
+  r.velocity_init_mean = 0.5;
+  r.velocity_init_variance = 0.0;
+  TopologicalParticleFilter g(map, r, 9);
+  ASSERT_TRUE(g.update(obsAt(0.0, {2}, {1.0})).ok());
+  ASSERT_TRUE(g.predictTo(2.0));
+  std::size_t reversed = 0;
+  for (const auto& q : g.particles()) reversed += q.vx < 0.0f ? 1 : 0;
+  EXPECT_NEAR(static_cast<double>(reversed) / g.particles().size(), 1.0 - std::exp(-0.05 * 2.0), 0.01);
 }

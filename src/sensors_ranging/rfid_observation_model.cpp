@@ -30,6 +30,8 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "negative_window", o.negative_window);
   core::readOption(y, c, "negative_period", o.negative_period);
   core::readOption(y, c, "p_detect", o.p_detect);
+  core::readOption(y, c, "attempt_rate", o.attempt_rate);
+  core::readOption(y, c, "max_failed_attempts", o.max_failed_attempts);
   if (unknown) {
     const std::vector<std::string> known = {"read_model",
                                             "p_max",
@@ -45,6 +47,8 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "negative_information",
                                             "negative_window",
                                             "negative_period",
+                                            "attempt_rate",
+                                            "max_failed_attempts",
                                             "p_detect",
                                             "map_frame",
                                             "observation_topic",
@@ -84,6 +88,10 @@ RfidObservationModel::RfidObservationModel(core::PickerRegistry registry,
                                            RfidModelOptions options)
     : registry_(std::move(registry)), map_(std::move(map)), options_(options) {
   if (!map_) throw std::invalid_argument("RfidObservationModel: no map");
+  if (!(options_.attempt_rate >= 0.0) || !std::isfinite(options_.attempt_rate))
+    throw std::invalid_argument("RfidObservationModel: attempt_rate must be finite and >= 0");
+  if (options_.max_failed_attempts < 0)
+    throw std::invalid_argument("RfidObservationModel: max_failed_attempts must be >= 0");
   options_.p_detect = std::clamp(options_.p_detect, 0.0, 1.0);
   if (options_.read_model == "disc") {
     logistic_ = false;
@@ -176,6 +184,17 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     antenna_session_start_[read.antenna_id] = read.stamp;
   antenna_last_stamp_[read.antenna_id] =
       std::max(read.stamp, last == antenna_last_stamp_.end() ? read.stamp : last->second);
+  // Failed attempts of this antenna on this picker's tag since its previous read (see attempt_rate).
+  int failed = 0;
+  {
+    auto prev = last_read_.find({read.antenna_id, *picker});
+    if (options_.attempt_rate > 0.0 && logistic_ && prev != last_read_.end()) {
+      const double gap = read.stamp - prev->second;
+      if (gap > 0.0 && gap <= options_.negative_window)
+        failed = std::clamp(static_cast<int>(std::lround(gap * options_.attempt_rate)) - 1, 0,
+                            options_.max_failed_attempts);
+    }
+  }
   last_read_[{read.antenna_id, *picker}] = read.stamp;
   ++counters_.accepted;
 
@@ -191,8 +210,10 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     obs.likelihood.assign(1, 1.0);
   } else {
     obs.likelihood.reserve(obs.nodes.size());
-    for (topology::NodeIndex n : obs.nodes)  // L(n) = p_read(d(n)); the TPF normalises
-      obs.likelihood.push_back(readProbability((map_->position2d(n) - read.antenna_pose.head<2>()).norm()));
+    for (topology::NodeIndex n : obs.nodes) {  // L(n) = p_read(d(n)) (1 - p_read(d(n)))^m; the TPF normalises
+      const double p = readProbability((map_->position2d(n) - read.antenna_pose.head<2>()).norm());
+      obs.likelihood.push_back(p * std::pow(std::max(1.0 - p, 1e-3), failed));
+    }
   }
   obs.position = read.antenna_pose.head<2>();
   obs.position_covariance = Eigen::Matrix2d::Identity() * position_variance_;

@@ -1,5 +1,6 @@
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -71,8 +72,86 @@ struct TopologicalParticleFilter::MotionGraph {
   std::vector<std::uint32_t> offsets;  // |N| + 1
   std::vector<Arc> arcs;               // grouped by source node
   std::size_t max_degree = 0;
+  // Lane-change paths (TpfParams::lane_change_model): lane end, non-lane nodes..., adjacent lane's end, its
+  // next lane node; exits of node n are exit_paths[exit_offsets[n] .. exit_offsets[n + 1]).
+  std::vector<std::vector<NodeIndex>> lane_paths;
+  std::vector<std::uint32_t> exit_offsets, exit_paths;
 
-  MotionGraph(const topology::TopologicalMap& map, bool directed) {
+  void buildLaneChangePaths(const topology::TopologicalMap& map, bool directed, int max_hops) {
+    const std::size_t n = map.numNodes();
+    std::vector<std::vector<std::uint32_t>> exits(n);
+    std::vector<int> depth(n, -1);
+    std::vector<NodeIndex> parent(n, topology::kInvalidNode), visited;
+    for (std::size_t l = 0; l < map.numLanes(); ++l) {
+      const auto lane = static_cast<topology::LaneIndex>(l);
+      const auto& nodes = map.laneNodes(lane);
+      if (nodes.size() < 2) continue;
+      // Lane axis by PCA of the node positions; "sides" are the two half-planes of its normal.
+      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+      for (NodeIndex i : nodes) mean += map.position2d(i);
+      mean /= static_cast<double>(nodes.size());
+      Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+      for (NodeIndex i : nodes) {
+        const Eigen::Vector2d d = map.position2d(i) - mean;
+        cov += d * d.transpose();
+      }
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+      const Eigen::Vector2d axis = eig.eigenvectors().col(1);
+      const Eigen::Vector2d normal(-axis.y(), axis.x());
+      for (NodeIndex e : nodes) {
+        int in_lane = 0;
+        for (NodeIndex k : map.motionNeighbours(e, directed)) in_lane += map.lane(k) == lane ? 1 : 0;
+        if (in_lane > 1) continue;  // not an end of the lane
+        // BFS from the end through non-lane nodes; nodes of other lanes end a path.
+        struct Best {
+          NodeIndex t = topology::kInvalidNode;
+          double dist = 1e300;
+        } best[2];
+        visited.clear();
+        depth[e] = 0;
+        visited.push_back(e);
+        for (std::size_t head = 0; head < visited.size(); ++head) {
+          const NodeIndex a = visited[head];
+          if (depth[a] >= max_hops || (a != e && map.lane(a) >= 0)) continue;
+          for (NodeIndex k : map.motionNeighbours(a, directed)) {
+            if (depth[k] >= 0 || map.lane(k) == lane) continue;
+            depth[k] = depth[a] + 1;
+            parent[k] = a;
+            visited.push_back(k);
+            if (map.lane(k) < 0) continue;
+            const Eigen::Vector2d d = map.position2d(k) - map.position2d(e);
+            const double side = d.dot(normal);
+            if (std::abs(side) < 0.1) continue;  // straight ahead: not a neighbouring lane
+            Best& b = best[side > 0.0 ? 0 : 1];
+            if (d.norm() < b.dist) b = {k, d.norm()};
+          }
+        }
+        for (const Best& b : best) {
+          if (b.t == topology::kInvalidNode) continue;
+          std::vector<NodeIndex> path;
+          for (NodeIndex k = b.t; k != e; k = parent[k]) path.push_back(k);
+          path.push_back(e);
+          std::reverse(path.begin(), path.end());
+          const auto target_lane = map.lane(b.t);
+          for (NodeIndex k : map.motionNeighbours(b.t, directed))
+            if (map.lane(k) == target_lane) {
+              path.push_back(k);  // one node into the new lane: the particle then walks along it
+              break;
+            }
+          exits[e].push_back(static_cast<std::uint32_t>(lane_paths.size()));
+          lane_paths.push_back(std::move(path));
+        }
+        for (NodeIndex k : visited) depth[k] = -1;
+      }
+    }
+    exit_offsets.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      exit_offsets[i + 1] = exit_offsets[i] + static_cast<std::uint32_t>(exits[i].size());
+      exit_paths.insert(exit_paths.end(), exits[i].begin(), exits[i].end());
+    }
+  }
+
+  MotionGraph(const topology::TopologicalMap& map, bool directed, bool lane_change, int max_hops) {
     const std::size_t n = map.numNodes();
     offsets.resize(n + 1, 0);
     for (NodeIndex i = 0; i < n; ++i) {
@@ -93,6 +172,7 @@ struct TopologicalParticleFilter::MotionGraph {
         arcs.push_back(a);
       }
     }
+    if (lane_change) buildLaneChangePaths(map, directed, max_hops);
   }
 };
 
@@ -123,7 +203,10 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   if (!map_ || map_->numNodes() == 0) throw std::invalid_argument("TopologicalParticleFilter: empty map");
   const std::string problem = params_.validate();
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
-  graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion);
+  graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion,
+                                               params_.lane_change_model &&
+                                                   params_.motion_model == MotionModel::kVelocity,
+                                               params_.lane_change_max_hops);
   edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   node_scratch_a_.assign(map_->numNodes(), 0.0);
@@ -333,8 +416,38 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
     p.vx = static_cast<float>(vel(rng_));
     p.vy = static_cast<float>(vel(rng_));
     p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
+    p.lane_change = 0;
   }
   unconnected_p_ = params_.unconnected_jump_probability;
+}
+
+void TopologicalParticleFilter::reinitialisePart(const core::Observation& obs, double fraction) {
+  // Departure from Alg. 1 l. 6 (reinit_fraction < 1): only every (1/fraction)-th particle is drawn again from
+  // Eq. 1, the rest keep the belief. A contradicting observation that is right wins within a few updates (the
+  // redrawn particles carry its weight); one that is wrong (an RFID ring 5-8 m from the antenna, a biased
+  // fix) no longer scatters the whole belief.
+  const std::size_t n = particles_.size();
+  const std::size_t count = std::max<std::size_t>(1, static_cast<std::size_t>(fraction * static_cast<double>(n)));
+  std::vector<double> cumulative;
+  cumulative.reserve(obs.likelihood.size());
+  double c = 0.0;
+  for (double l : obs.likelihood) cumulative.push_back(c += l);
+  if (!(c > 0.0)) return;
+  std::normal_distribution<double> vel(params_.velocity_init_mean, std::sqrt(params_.velocity_init_variance));
+  const double span = params_.dwell_init_max - params_.dwell_init_min;
+  for (std::size_t j = 0; j < count; ++j) {
+    Particle& p = particles_[(j * n) / count];
+    const double u = uniform01(rng_) * c;
+    const std::size_t k = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
+        cumulative.size() - 1);
+    p.node = obs.nodes[k];
+    p.vx = static_cast<float>(vel(rng_));
+    p.vy = static_cast<float>(vel(rng_));
+    p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
+    p.lane_change = 0;
+  }
+  unconnected_p_ = params_.unconnected_jump_probability;  // Alg. 1 l. 8
 }
 
 void TopologicalParticleFilter::predict(double dt) {
@@ -371,9 +484,24 @@ void TopologicalParticleFilter::predict(double dt) {
     }
     return;
   }
+  // Not in the paper: pickers turn round in the middle of a lane (Table I p_reverse). Without a turn the
+  // velocity model cannot follow them (the back edge has b = 0), so each particle reverses its velocity with
+  // probability 1 - exp(-reverse_rate dt) per step (geometric gaps: one draw per reversing particle).
+  if (params_.reverse_rate > 0.0 && dt > 0.0) {
+    const double p_rev = 1.0 - std::exp(-params_.reverse_rate * dt);
+    if (p_rev > 0.0) {
+      std::geometric_distribution<std::size_t> gap(std::min(p_rev, 1.0));
+      for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
+        particles_[i].vx = -particles_[i].vx;
+        particles_[i].vy = -particles_[i].vy;
+      }
+    }
+  }
   std::vector<double>& contrib = edge_scratch_;  // (sized to the largest degree at construction)
   std::vector<double>& proj = projection_scratch_;
   const double turn_fraction = params_.turn_projection_fraction;
+  const bool follow_edge = params_.velocity_follows_edge;
+  const double leak = params_.lane_change_leak;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
     const double tau0 = static_cast<double>(p.dwell), tau = tau0 + dt;
@@ -386,13 +514,30 @@ void TopologicalParticleFilter::predict(double dt) {
     // literal mode = Eq. 2 / 3 at tau; step-consistent mode = the same conditioned on no earlier jump.
     // Turning: when no edge lies within acos(turn_fraction) of the velocity (lane end, corner into the
     // headland), every edge gets b = |v| (see turn_projection_fraction).
-    double max_proj = 0.0;
-    for (std::uint32_t e = begin; e < end; ++e) {
-      const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
-      proj[e - begin] = b;
-      max_proj = std::max(max_proj, b);
+    // On a lane-change path: the path's next node gets b = |v|, every other edge lane_change_leak |v|.
+    NodeIndex path_next = topology::kInvalidNode;
+    if (p.lane_change != 0) {
+      const auto& path = g.lane_paths[p.lane_change - 1];
+      const auto at = std::find(path.begin(), path.end(), p.node);
+      if (at != path.end() && at + 1 != path.end())
+        path_next = *(at + 1);
+      else
+        p.lane_change = 0;
     }
-    if (max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
+    double max_proj = 0.0;
+    if (path_next != topology::kInvalidNode) {
+      const double speed = std::sqrt(vx * vx + vy * vy);
+      for (std::uint32_t e = begin; e < end; ++e)
+        proj[e - begin] = g.arcs[e].length > 0.0 ? (g.arcs[e].target == path_next ? speed : leak * speed) : 0.0;
+      max_proj = speed;
+    } else {
+      for (std::uint32_t e = begin; e < end; ++e) {
+        const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
+        proj[e - begin] = b;
+        max_proj = std::max(max_proj, b);
+      }
+    }
+    if (path_next == topology::kInvalidNode && max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
       const double speed = std::sqrt(vx * vx + vy * vy);
       for (std::uint32_t e = begin; e < end; ++e) proj[e - begin] = g.arcs[e].length > 0.0 ? speed : 0.0;
     }
@@ -428,10 +573,49 @@ void TopologicalParticleFilter::predict(double dt) {
       const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
       const auto& arc = g.arcs[e];
       const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
-      p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
-      p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
+      if (follow_edge) {
+        // Departure from Eq. 7 (velocity_follows_edge): Eq. 7 smooths the speed only; the heading becomes the
+        // edge taken, so a particle that turned (lane end, headland corner) keeps walking the way it turned
+        // instead of pointing back along the lane it left for ~V jumps.
+        const double speed = std::sqrt(vx * vx + vy * vy);
+        const double s = speed + pr * (arc.length * inv_t - speed) * inv_window;
+        p.vx = static_cast<float>(arc.ux * s);
+        p.vy = static_cast<float>(arc.uy * s);
+      } else {
+        p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
+        p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
+      }
+      const NodeIndex from = p.node;
       p.node = arc.target;
       p.dwell = 0.0f;
+      if (path_next != topology::kInvalidNode) {
+        // Followed the path (ends one node inside the new lane) or left it.
+        const auto& path = g.lane_paths[p.lane_change - 1];
+        if (arc.target != path_next || path.back() == arc.target) p.lane_change = 0;
+      } else if (g.exit_offsets.size() > from + 1 && g.exit_offsets[from] != g.exit_offsets[from + 1] &&
+                 map_->lane(arc.target) != map_->lane(from)) {
+        // Left the lane at an end: take a lane-change path that starts with this jump (the side is chosen by
+        // the jump; when both sides share the first node, one at random).
+        std::uint32_t first = 0, found = 0;
+        for (std::uint32_t k = g.exit_offsets[from]; k < g.exit_offsets[from + 1]; ++k)
+          if (g.lane_paths[g.exit_paths[k]][1] == arc.target) {
+            if (found == 0) first = k;
+            ++found;
+          }
+        if (found > 0) {
+          std::uint32_t pick = first;
+          if (found > 1) {
+            std::uint32_t skip = static_cast<std::uint32_t>(rng_() % found);
+            for (std::uint32_t k = first; k < g.exit_offsets[from + 1]; ++k)
+              if (g.lane_paths[g.exit_paths[k]][1] == arc.target && skip-- == 0) {
+                pick = k;
+                break;
+              }
+          }
+          const auto& path = g.lane_paths[g.exit_paths[pick]];
+          p.lane_change = path.back() == arc.target ? 0 : g.exit_paths[pick] + 1;
+        }
+      }
     }
     if (count[p.node] == 0.0) touched_.push_back(p.node);
     count[p.node] += 1.0;
@@ -474,9 +658,16 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   // Alg. 1 l. 6, with the guard that the observation must contradict the particles (mean L / max L below
   // reinit_max_mean_likelihood): a flat, negative-information likelihood ("not near this antenna") is far
   // from a concentrated belief in JSD yet agrees with it, and must not spread the belief over the map.
-  if (params_.jsd_monitor && obs.identifying && belief_.jsd > params_.jsd_threshold && !result.initialised &&
+  const bool may_reinit =
+      params_.reinit_sensors.empty() ||
+      std::find(params_.reinit_sensors.begin(), params_.reinit_sensors.end(), obs.sensor) != params_.reinit_sensors.end();
+  if (params_.jsd_monitor && may_reinit && obs.identifying && belief_.jsd > params_.jsd_threshold &&
+      !result.initialised &&
       (mean_l < params_.reinit_max_mean_likelihood || params_.reinit_max_mean_likelihood >= 1.0)) {
-    initialise(obs);  // Alg. 1 l. 6-9 (initialise() sets p_rj back to its initial value, l. 8)
+    if (params_.reinit_fraction >= 1.0)
+      initialise(obs);  // Alg. 1 l. 6-9 (initialise() sets p_rj back to its initial value, l. 8)
+    else
+      reinitialisePart(obs, params_.reinit_fraction);
     belief_.reinitialised = true;
     result.reinitialised = true;
     ++counters_.reinitialisations;
@@ -609,6 +800,7 @@ void TopologicalParticleFilter::addNoise() {
     for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
       particles_[i].node = static_cast<NodeIndex>(rng_() % n_nodes);
       particles_[i].dwell = 0.0f;
+      particles_[i].lane_change = 0;
     }
   }
   // The 32 spare random bits of each particle's prediction draw (spare_bits_, see normalTable()). The

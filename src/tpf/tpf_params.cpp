@@ -18,6 +18,7 @@ TpfParams::TpfParams() {
   // Not in the paper: UWB identifies like RFID; a camera is anonymous like LiDAR.
   sensor_gammas["uwb"] = SensorGamma{1.0, 0.0};
   sensor_gammas["camera"] = SensorGamma{0.25, 0.0};
+  reinit_sensors = {"gnss", "uwb"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
 }
 
 SensorGamma TpfParams::gammaFor(const std::string& sensor) const {
@@ -43,6 +44,10 @@ std::string TpfParams::validate() const {
     return "dwell_noise_min must be <= dwell_noise_max";
   if (!finite_nonneg(fixed_lambda)) return "fixed_lambda must be >= 0";
   if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window)) return "velocity_window must be >= 1";
+  if (!(reinit_fraction > 0.0 && reinit_fraction <= 1.0)) return "reinit_fraction must be in (0, 1]";
+  if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0)) return "lane_change_leak must be in [0, 1]";
+  if (lane_change_max_hops < 1) return "lane_change_max_hops must be >= 1";
+  if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate)) return "reverse_rate must be finite and >= 0";
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
     return "turn_projection_fraction must be in [0, 1]";
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell)) return "min_jump_dwell must be > 0";
@@ -148,10 +153,17 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "gamma_as_confidence", p.gamma_as_confidence);
   read(node, "min_velocity_sigma", p.min_velocity_sigma);
   read(node, "velocity_weight_product", p.velocity_weight_product);
+  read(node, "velocity_follows_edge", p.velocity_follows_edge);
+  read(node, "reverse_rate", p.reverse_rate);
+  read(node, "lane_change_model", p.lane_change_model);
+  read(node, "lane_change_leak", p.lane_change_leak);
+  read(node, "lane_change_max_hops", p.lane_change_max_hops);
   read(node, "accepted_sensors", p.accepted_sensors);
   read(node, "jsd_monitor", p.jsd_monitor);
   read(node, "jsd_threshold", p.jsd_threshold);
   read(node, "reinit_max_mean_likelihood", p.reinit_max_mean_likelihood);
+  read(node, "reinit_fraction", p.reinit_fraction);
+  read(node, "reinit_sensors", p.reinit_sensors);
   read(node, "entropy_gate", p.entropy_gate);
   read(node, "entropy_threshold", p.entropy_threshold);
   read(node, "unconnected_jump_probability", p.unconnected_jump_probability);
@@ -174,12 +186,24 @@ TpfParams TpfParams::fromYamlFile(const std::string& path) {
 }
 
 std::vector<std::string> TpfParams::methodNames() {
-  return {"tpf", "khan_connected", "khan_unconnected", "no_monitor", "constant_speed"};
+  return {"tpf", "paper_tpf", "khan_connected", "khan_unconnected", "no_monitor", "constant_speed"};
 }
 
 TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams& base) {
   TpfParams p = base;
   if (method == "tpf") return p;
+  if (method == "paper_tpf") {
+    // Navigate-and-Seek's filter read literally: Eq. 7 blends the velocity vector, Eq. 8 adds the velocity
+    // term, particles turn only at lane ends, no lane-change structure, Algorithm 1's JSD re-initialisation.
+    p.velocity_follows_edge = false;
+    p.velocity_weight_product = false;
+    p.reverse_rate = 0.0;
+    p.lane_change_model = false;
+    p.jsd_monitor = true;
+    p.reinit_fraction = 1.0;
+    p.reinit_sensors.clear();
+    return p;
+  }
   if (method == "khan_connected" || method == "khan_unconnected") {
     // Khan et al. [1]: GNSS only, fixed lambda 0.1, no monitors; "unconnected" lets a small share of the
     // particles jump anywhere at every resampling (fixed p_rj), "connected" never.

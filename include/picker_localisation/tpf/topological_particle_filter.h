@@ -74,6 +74,7 @@ struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
   float dwell = 0.0f;                                 // tau, s
+  std::uint32_t lane_change = 0;  // 1 + index of the lane-change path being walked (0: none); see TpfParams
 };
 
 enum class UpdateStatus {
@@ -172,6 +173,7 @@ class TopologicalParticleFilter {
 
   UpdateResult reject(UpdateStatus status, std::string reason);
   void initialise(const core::Observation& obs);
+  void reinitialisePart(const core::Observation& obs, double fraction);
   void predict(double dt);
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
