@@ -6,7 +6,7 @@ target_compile_definitions(test_vision_data PRIVATE PL_MIN_LEG_RECALL=0.42 PL_MI
                            PL_MAX_FALSE_LEGS_PER_SCAN=0.9)
 # rostest: leg_detector on real scans + static tf; empty scan and missing tf must not kill it.
 add_rostest_gtest(test_leg_detector_node test/leg_detector.test test/test_leg_detector_node.cpp)
-target_link_libraries(test_leg_detector_node picker_localisation_ros)
+target_link_libraries(test_leg_detector_node picker_localisation_vision_ros)
 # rostest: camera_detector on a vtest.avi frame (bearing, stale frames, rate limit, missing CameraInfo).
 add_rostest_gtest(test_camera_detector_node test/camera_detector.test test/test_camera_detector_node.cpp)
 target_link_libraries(test_camera_detector_node picker_localisation_ros ${OpenCV_LIBS})

@@ -55,6 +55,7 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }, 10.0));
   send(p1, fixAt(datum, where, t0));                                        // repeated stamp
   send(p1, fixAt(datum, where, t0 - ros::Duration(1.0)));                   // backwards
+  send(p1, fixAt(datum, where, ros::Time(4102444800.0)));                   // 2100-01-01: far future, dropped
   send(p1, fixAt(datum, where + Eigen::Vector2d(0.5, 0.0), t0 + ros::Duration(1.0)));  // good again
   send(p2, fixAt(datum, Eigen::Vector2d(25.0, -30.0), t0 + ros::Duration(1.0)));       // other picker
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 3; }, 10.0));
@@ -78,7 +79,8 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   ASSERT_TRUE(ranging_test::waitFor(
       [&] { return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"] == "1/1/1/2/0"; }, 5.0))
       << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"];
-  EXPECT_EQ(c.diag["picker_1 accepted"], "2");
+  EXPECT_EQ(c.diag["picker_1 accepted"], "2");  // the fix after the 2100 one was accepted: nothing blocked
+  EXPECT_EQ(c.diag["fixes stamped in the future (rejected)"], "1");
 }
 
 int main(int argc, char** argv) {

@@ -20,6 +20,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
+#include "picker_localisation/ros/leg_detector_node.h"
 #include "vision_rostest_util.h"
 
 using vision_test::waitFor;
@@ -202,6 +203,29 @@ TEST(LegDetectorNode, PointCloudPerson) {
     *y = p.y();
     *z = p.z();
     ++x, ++y, ++z;
+  }
+  // Malformed clouds first (issue 17: SIGSEGV on width x point_step beyond the data): dropped, node alive.
+  {
+    sensor_msgs::PointCloud2 bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    bad.width = 100000000;
+    bad.row_step = bad.width * bad.point_step;
+    bad.data.resize(12);
+    pub.publish(bad);
+    bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    bad.point_step = 0;
+    pub.publish(bad);
+    bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    for (auto& f : bad.fields) f.datatype = sensor_msgs::PointField::FLOAT64;
+    pub.publish(bad);
+    bad = cloud;
+    bad.header.stamp = ros::Time(4102444800.0);  // 2100: ros::Duration threw in the tf lookup
+    pub.publish(bad);
+    waitFor([] { return false; }, 0.5);
+    EXPECT_TRUE(rec.people.empty());
+    EXPECT_EQ(picker_localisation::ros_adapter::cloudProblem(cloud), "");
   }
   for (int k = 0; k < 5; ++k) {
     cloud.header.stamp = ros::Time::now();

@@ -197,6 +197,11 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
       ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
   stale.header.stamp = ros::Time(1.0);
   pub_.publish(stale);
+  // A stamp in 2100: dropped (adopting it would block every later observation and start ~6e8 predictions).
+  picker_localisation::Observation future =
+      ros_adapter::toMsg(observationAt(node_b, "gnss", "picker_1"), *map_);
+  future.header.stamp = ros::Time(4102444800.0);
+  pub_.publish(future);
   spinFor(0.5);
   picker_localisation::WhatIf after;
   ASSERT_TRUE(what_if.call(after));
@@ -211,10 +216,13 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
           if (st.hardware_id == "picker_1") statuses.push_back(st);
       });
   ASSERT_TRUE(waitFor([&] { return !statuses.empty(); }, 5.0));
-  bool has_rejected = false;
-  for (const auto& kv : statuses.back().values)
+  bool has_rejected = false, has_future = false;
+  for (const auto& kv : statuses.back().values) {
     if (kv.key == "rejected (invalid)") has_rejected = std::stoi(kv.value) >= 1;
+    if (kv.key == "observations stamped in the future (dropped)") has_future = kv.value == "1";
+  }
   EXPECT_TRUE(has_rejected);
+  EXPECT_TRUE(has_future);
 
   // 8. Reset: the belief is forgotten; the next observation initialises it again.
   ros::ServiceClient reset = nh_.serviceClient<picker_localisation::ResetBelief>("/pickers/picker_1/reset");

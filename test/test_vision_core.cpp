@@ -285,3 +285,15 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
     }
   }
 }
+
+// Images smaller than the HOG window (64 x 128) or of another type crashed OpenCV 4.6 (issue 17): no boxes now.
+TEST(HogPersonDetector, TinyAndOddImagesGiveNoBoxesAndNoCrash) {
+  picker_localisation::sensors::HogPersonDetector hog;
+  for (const cv::Size s : {cv::Size(1, 1), cv::Size(10, 10), cv::Size(128, 64), cv::Size(640, 2), cv::Size(63, 127),
+                           cv::Size(2, 640)})
+    EXPECT_TRUE(hog.detect(cv::Mat(s, CV_8UC3, cv::Scalar::all(128))).empty()) << s;
+  EXPECT_TRUE(hog.detect(cv::Mat(200, 100, CV_8UC1, cv::Scalar::all(128))).empty());
+  EXPECT_TRUE(hog.detect(cv::Mat(200, 100, CV_32FC3, cv::Scalar::all(0.5))).empty());
+  // A frame of the window size is processed (whatever it finds).
+  EXPECT_NO_THROW(hog.detect(cv::Mat(128, 64, CV_8UC3, cv::Scalar::all(128))));
+}

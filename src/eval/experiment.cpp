@@ -74,7 +74,7 @@ const char* toString(Scenario s) {
 
 namespace {
 
-enum class Tracker { kTpf, kUkf };
+enum class Tracker { kTpf, kUkf, kRawFix };
 enum class RobotPolicy { kPatrol, kEstimatedNode, kNbs };
 
 // What a method is made of. The TPF preset names are TpfParams::presetForMethod's.
@@ -90,6 +90,10 @@ const std::vector<MethodSpec>& methodSpecs() {
   static const std::vector<MethodSpec> specs = {
       {"khan_connected", Tracker::kTpf, "khan_connected", true, false, false, RobotPolicy::kPatrol},
       {"khan_unconnected", Tracker::kTpf, "khan_unconnected", true, false, false, RobotPolicy::kPatrol},
+      // Not in Table II: the node nearest the latest accepted fix (no filter; Khan et al. Fig. 3c's reference),
+      // and the full TPF on GNSS alone.
+      {"raw_fix", Tracker::kRawFix, "", true, false, false, RobotPolicy::kPatrol},
+      {"gnss_tpf", Tracker::kTpf, "tpf", true, false, false, RobotPolicy::kPatrol},
       {"lidar_gnss", Tracker::kTpf, "tpf", true, true, false, RobotPolicy::kPatrol},
       {"rfid_gnss", Tracker::kTpf, "tpf", true, false, true, RobotPolicy::kPatrol},
       {"rfid_lidar_gnss", Tracker::kTpf, "tpf", true, true, true, RobotPolicy::kPatrol},
@@ -254,6 +258,7 @@ struct PickerTrack {
   std::unique_ptr<tpf::TopologicalParticleFilter> tpf;
 #endif
   std::unique_ptr<sensors::GnssIngest> gnss;
+  NodeIndex raw_fix_node = topology::kInvalidNode;  // raw_fix: the node nearest the latest accepted fix
 };
 
 }  // namespace
@@ -401,7 +406,9 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         PickerTrack& t = tracks.at(f.picker_index);
         const sensors::GnssResult r = t.gnss->process(toIngestFix(f));
         if (!r.accepted()) continue;
-        if (spec.tracker == Tracker::kUkf) {
+        if (spec.tracker == Tracker::kRawFix) {
+          t.raw_fix_node = map->nearestNode(r.position);
+        } else if (spec.tracker == Tracker::kUkf) {
           Eigen::Matrix2d enu;
           enu << f.position_covariance[0], f.position_covariance[1], f.position_covariance[3],
               f.position_covariance[4];
@@ -479,6 +486,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         if (spec.tracker == Tracker::kUkf) {
           if (auto p = ukf.estimate(tracks[i].id)) est = map->nearestNode(*p);
         }
+        if (spec.tracker == Tracker::kRawFix) est = tracks[i].raw_fix_node;
         if (est == topology::kInvalidNode) continue;  // no estimate yet (before the first observation)
         result.samples.push_back(
             computeError(*map, est, simulator.pickerPose(i).position(), next_sample, tracks[i].id));

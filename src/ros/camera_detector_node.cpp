@@ -15,6 +15,7 @@ CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("bearing_frame", bearing_frame_, bearing_frame_);
   pnh_.param("max_rate", max_rate_, max_rate_);
   pnh_.param("max_age", max_age_, max_age_);
+  stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
   pnh_.param("horizontal_fov", horizontal_fov_, horizontal_fov_);
   std::string onnx;
   pnh_.param("onnx_model", onnx, onnx);
@@ -56,13 +57,23 @@ void CameraDetectorNode::infoCallback(const sensor_msgs::CameraInfo::ConstPtr& m
 void CameraDetectorNode::imageCallback(const sensor_msgs::Image::ConstPtr& msg) {
   ++received_;
   const ros::Time stamp = msg->header.stamp;
-  if (max_age_ > 0.0 && (ros::Time::now() - stamp).toSec() > max_age_) {
+  if (stamp_guard_.tooFarInFuture(stamp)) {
+    ++dropped_future_;
+    ROS_WARN_THROTTLE(10.0, "%s: frame stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                      ros::this_node::getName().c_str(), stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
+  if (stamp_guard_.clockJumpedBack()) {
+    ROS_WARN("%s: the clock jumped back: frame-rate state reset", ros::this_node::getName().c_str());
+    last_processed_ = ros::Time();
+  }
+  if (max_age_ > 0.0 && secondsBetween(stamp, ros::Time::now()) > max_age_) {
     ++dropped_stale_;
     ROS_WARN_THROTTLE(10.0, "%s: dropping frames older than %.2f s", ros::this_node::getName().c_str(), max_age_);
     return;
   }
   if (max_rate_ > 0.0 && !last_processed_.isZero() && stamp >= last_processed_ &&
-      (stamp - last_processed_).toSec() < 1.0 / max_rate_) {
+      secondsBetween(last_processed_, stamp) < 1.0 / max_rate_) {
     ++dropped_rate_;
     return;
   }
@@ -137,6 +148,7 @@ void CameraDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
   stat.add("dropped: rate limit", dropped_rate_);
   stat.add("dropped: no camera info", dropped_no_info_);
   stat.add("dropped: bad encoding", bad_images_);
+  stat.add("dropped: stamp in the future", dropped_future_);
   stat.add("boxes published", boxes_);
   stat.add("last processing time (s)", last_processing_s_);
 }

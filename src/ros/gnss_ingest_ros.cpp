@@ -27,15 +27,9 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
   sensors::GnssIngestOptions o;
-  try {
-    std::vector<std::string> unknown;
-    o = sensors::GnssIngestOptions::fromYaml(paramsAsYaml(pnh), &unknown);
-    for (const auto& u : unknown) ROS_WARN("%s", u.c_str());
-  } catch (const std::exception& e) {
-    ROS_FATAL("%s", e.what());
-    return;
-  }
+  if (!loadOptions(pnh, o)) return;
   pnh.param<std::string>("frame_id", frame_id_, "map");
+  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   double map_timeout = 30.0;
   pnh.param("map_timeout", map_timeout, map_timeout);
   map_ = obtainMap(nh, pnh, map_timeout);
@@ -60,7 +54,19 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t i) {
+  if (stamp_guard_.clockJumpedBack()) {
+    // A bag replayed with -l or a simulator restart: forget every picker's fix history (else every later fix
+    // would be "not after the last accepted one" until the new stamps overtake the old).
+    ROS_WARN("gnss_ingest: the clock jumped back: fix histories reset");
+    for (auto& ingest : ingest_) ingest = sensors::GnssIngest(ingest.pickerId(), map_, ingest.datum(), ingest.options());
+  }
   sensors::GnssIngest& g = ingest_[i];
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
+    ++future_stamps_;
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix stamped %.3f is more than %.1f s ahead of the clock: rejected",
+                      g.pickerId().c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
   sensors::GnssResult r = g.process(gnssFixFromMsg(*msg));
   if (!r.accepted()) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(),
@@ -76,6 +82,8 @@ void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::siz
 void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   const double now = ros::Time::now().toSec();
   std::size_t blackout = 0, rejected = 0;
+  stat.add("fixes stamped in the future (rejected)", future_stamps_);
+  stat.add("clock jumps back", stamp_guard_.jumps());
   for (const sensors::GnssIngest& g : ingest_) {
     const sensors::GnssCounters& c = g.counters();
     const std::string k = g.pickerId() + " ";

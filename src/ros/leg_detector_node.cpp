@@ -17,23 +17,37 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+std::string cloudProblem(const sensor_msgs::PointCloud2& c) {
+  const std::uint64_t points = static_cast<std::uint64_t>(c.width) * c.height;
+  if (c.point_step == 0) return "point_step is 0";
+  if (c.row_step < static_cast<std::uint64_t>(c.width) * c.point_step) return "row_step < width x point_step";
+  if (static_cast<std::uint64_t>(c.row_step) * c.height > c.data.size())
+    return "data holds " + std::to_string(c.data.size()) + " bytes, row_step x height needs " +
+           std::to_string(static_cast<std::uint64_t>(c.row_step) * c.height);
+  if (points > 10000000) return "more than 10,000,000 points";
+  for (const char* axis : {"x", "y", "z"}) {
+    const sensor_msgs::PointField* f = nullptr;
+    for (const auto& field : c.fields)
+      if (field.name == axis) f = &field;
+    if (!f) return std::string("no field ") + axis;
+    if (f->datatype != sensor_msgs::PointField::FLOAT32)
+      return std::string("field ") + axis + " is not FLOAT32";
+    if (f->offset + 4u > c.point_step) return std::string("field ") + axis + " lies beyond point_step";
+  }
+  return "";
+}
+
 LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
   pnh_.param("fixed_frame", fixed_frame_, fixed_frame_);
   pnh_.param("robot_id", robot_id_, robot_id_);
   pnh_.param("tf_timeout", tf_timeout_, tf_timeout_);
   pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
+  stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
 
   // The pipeline's options: every private parameter through the schema the offline runner uses too.
   sensors::LegPipelineOptions options;
-  try {
-    std::vector<std::string> unknown;
-    options = sensors::LegPipelineOptions::fromYaml(paramsAsYaml(pnh_), &unknown);
-    for (const auto& u : unknown) ROS_WARN("%s: %s", ros::this_node::getName().c_str(), u.c_str());
-  } catch (const std::exception& e) {
-    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
-    return;
-  }
+  if (!loadOptions(pnh_, options)) return;
   const std::string default_model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
   std::string model = pnh_.param("model_file", default_model);
   if (model.empty()) model = default_model;  // config/vision.yaml documents "" as the shipped model
@@ -88,7 +102,7 @@ bool LegDetectorNode::lookup(const std::string& target, const std::string& sourc
     out = Eigen::Translation3d(t.translation.x, t.translation.y, t.translation.z) *
           Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z);
     return true;
-  } catch (const tf2::TransformException& e) {
+  } catch (const std::exception& e) {  // tf2 exceptions, and ros::Duration's range error for absurd stamps
     ++tf_failures_;
     ROS_WARN_THROTTLE(5.0, "%s: no transform %s -> %s at %.3f: %s (input dropped)", ros::this_node::getName().c_str(),
                       source.c_str(), target.c_str(), stamp.toSec(), e.what());
@@ -96,8 +110,27 @@ bool LegDetectorNode::lookup(const std::string& target, const std::string& sourc
   }
 }
 
+bool LegDetectorNode::acceptStamp(const ros::Time& stamp, const char* what) {
+  if (stamp_guard_.clockJumpedBack()) {
+    ROS_WARN("%s: the clock jumped back: cluster tracks and camera state reset", ros::this_node::getName().c_str());
+    pipeline_->reset();
+    last_detections_.reset();
+  }
+  if (!stamp_guard_.tooFarInFuture(stamp)) return true;
+  ++future_stamps_;
+  ROS_WARN_THROTTLE(5.0, "%s: %s stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                    ros::this_node::getName().c_str(), what, stamp.toSec(), stamp_guard_.maxFuture());
+  return false;
+}
+
 void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) {
   ++scans_;
+  if (!acceptStamp(msg->header.stamp, "scan")) return;
+  if (msg->header.frame_id.empty()) {
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "%s: scan without a frame id dropped", ros::this_node::getName().c_str());
+    return;
+  }
   last_input_ = msg->header.stamp;
   const auto scan = toScanData(*msg);
   if (scan.validCount() == 0) {
@@ -113,6 +146,15 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
 
 void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
   ++clouds_;
+  if (!acceptStamp(msg->header.stamp, "cloud")) return;
+  // Validate the cloud against its own metadata before reading its data (pcl::fromROSMsg trusts it).
+  const std::string problem = cloudProblem(*msg);
+  if (!problem.empty()) {
+    ++bad_clouds_;
+    ROS_WARN_THROTTLE(5.0, "%s: malformed PointCloud2 dropped: %s", ros::this_node::getName().c_str(),
+                      problem.c_str());
+    return;
+  }
   last_input_ = msg->header.stamp;
   Eigen::Isometry3d tf;
   if (!lookup(fixed_frame_, msg->header.frame_id, msg->header.stamp, tf)) return;
@@ -135,6 +177,14 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
 
 void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
   ++camera_frames_;
+  if (!acceptStamp(msg->header.stamp, "camera detections")) return;
+  for (const auto& d : msg->detections)
+    if (!std::isfinite(d.bearing) || !std::isfinite(d.confidence)) {
+      ++bad_detections_;
+      ROS_WARN_THROTTLE(5.0, "%s: camera detections with a non-finite bearing dropped",
+                        ros::this_node::getName().c_str());
+      return;
+    }
   last_detections_ = msg;
 }
 
@@ -203,6 +253,10 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("clouds", clouds_);
   stat.add("empty inputs", empty_scans_);
   stat.add("tf failures (dropped)", tf_failures_);
+  stat.add("stamps in the future (dropped)", future_stamps_);
+  stat.add("malformed clouds (dropped)", bad_clouds_);
+  stat.add("non-finite camera detections (dropped)", bad_detections_);
+  stat.add("clock jumps back", stamp_guard_.jumps());
   stat.add("camera frames", camera_frames_);
   stat.add("people published", people_);
   stat.add("camera-confirmed people", fused_);

@@ -41,7 +41,7 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
     }
     out.linear() = eq.normalized().toRotationMatrix();
     return out;
-  } catch (const tf2::TransformException& e) {
+  } catch (const std::exception& e) {  // tf2 exceptions, and ros::Duration's range error for absurd stamps
     if (error) *error = e.what();
     return std::nullopt;
   }

@@ -14,15 +14,9 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const core::PickerRegistry& registry = *registry_opt;
   // One options schema, shared with the offline runner (config/rfid_ranging.yaml keys).
   sensors::RfidModelOptions o;
-  try {
-    std::vector<std::string> unknown;
-    o = sensors::RfidModelOptions::fromYaml(paramsAsYaml(pnh), &unknown);
-    for (const auto& u : unknown) ROS_WARN("%s", u.c_str());
-  } catch (const std::exception& e) {
-    ROS_FATAL("%s", e.what());
-    return;
-  }
+  if (!loadOptions(pnh, o)) return;
   pnh.param<std::string>("map_frame", map_frame_, "map");
+  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
   double map_timeout = 30.0;
   pnh.param("map_timeout", map_timeout, map_timeout);
@@ -47,6 +41,12 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {  // adopting it would reject every later read
+    ++future_stamps_;
+    ROS_WARN_THROTTLE(5.0, "rfid_ranging: read stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                      msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
   std::string error;
   const std::optional<Eigen::Isometry3d> t =
       lookupTransform(tf_buffer_, map_frame_, msg->header.frame_id, msg->header.stamp, tf_timeout_, &error);
@@ -82,6 +82,7 @@ void RfidRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   const sensors::RfidCounters& c = model_->counters();
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
+  stat.add("stamped in the future (dropped)", future_stamps_);
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

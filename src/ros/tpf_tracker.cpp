@@ -197,6 +197,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_
   what_if_srv_ = nh.advertiseService(base + "/what_if", &TpfTracker::whatIf, this);
   sub_ = nh.subscribe(observations_topic, 200, &TpfTracker::observationCallback, this);
   pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
+  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   ordering_ = core::StampOrderedBuffer<std::pair<core::Observation, std::string>>(std::max(0.0, ordering_latency_));
   if (ordering_latency_ > 0.0)
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
@@ -221,6 +222,14 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
     ++other_picker_;  // another picker's identifying observation: not ours
     return;
   }
+  checkClockJump();
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
+    // Adopting it would make every later observation "too old" and start ~(stamp - now) / period predictions.
+    ++future_stamps_;
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                      picker_id_.c_str(), msg->sensor.c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
   std::size_t unknown = 0;
   core::Observation obs = fromMsg(*msg, *map_, &unknown);
   if (unknown > 0) {
@@ -239,7 +248,18 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
   ordering_.push(obs.stamp, key, {std::move(obs), msg->sensor});
 }
 
+void TpfTracker::checkClockJump() {
+  if (!stamp_guard_.clockJumpedBack()) return;
+  ROS_WARN("tpf_tracker %s: the clock jumped back: belief reset, %zu waiting observation(s) dropped", picker_id_.c_str(),
+           ordering_.size());
+  ordering_.clear();
+  filter_->reset();
+  ++resets_;
+  publish();
+}
+
 void TpfTracker::orderingCallback(const ros::TimerEvent&) {
+  checkClockJump();
   const double now = ros::Time::now().toSec();
   if (now <= 0.0) return;
   for (auto& item : ordering_.release(now)) process(item.second.first, item.second.second);
@@ -247,8 +267,11 @@ void TpfTracker::orderingCallback(const ros::TimerEvent&) {
 
 void TpfTracker::predictDueUntil(double until) {
   if (prediction_period_ <= 0.0) return;
+  int steps = 0;
   while (filter_->initialised() && until - filter_->lastStamp() >= prediction_period_) {
-    if (!filter_->predictTo(filter_->lastStamp() + prediction_period_)) break;
+    const double next = ++steps < kMaxPredictionsPerCall ? filter_->lastStamp() + prediction_period_
+                                                          : until;  // a long silence: one step to `until`
+    if (!filter_->predictTo(next)) break;
     publish();
   }
 }
@@ -270,6 +293,7 @@ void TpfTracker::process(const core::Observation& obs, const std::string& sensor
 }
 
 void TpfTracker::timerCallback(const ros::TimerEvent&) {
+  checkClockJump();
   const double now = ros::Time::now().toSec();
   if (now <= 0.0 || !filter_->initialised()) return;  // sim clock not running yet / nothing to predict
   // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
@@ -338,6 +362,8 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   last_diag_time_ = now;
   last_diag_received_ = received_;
   stat.add("observations received", received_);
+  stat.add("observations stamped in the future (dropped)", future_stamps_);
+  stat.add("clock jumps back (belief reset)", stamp_guard_.jumps());
   stat.add("observations waiting for stamp order", ordering_.size());
   stat.add("ordering overflows", ordering_.forcedReleases());
   stat.add("accepted", c.accepted);

@@ -37,6 +37,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("reset_after", o.reset_after, o.reset_after);
   pnh.param("max_output_sigma", o.max_output_sigma, o.max_output_sigma);
   pnh.param<std::string>("map_frame", map_frame_, "map");
+  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   pnh.param<std::string>("base_frame", base_frame_, "");
   pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
   double map_timeout = 30.0, flush_period = 0.05;
@@ -86,6 +87,12 @@ std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, 
 }
 
 void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
+    ++future_stamps_;
+    ROS_WARN_THROTTLE(5.0, "uwb_ranging: range stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                      msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
   const std::string base = baseFrame(msg->robot_id);
   std::string error;
   std::optional<Eigen::Isometry2d> anchor = mount(base, msg->header.frame_id, msg->header.stamp, &error);
@@ -122,6 +129,10 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
 }
 
 void UwbRangingNode::onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
+    ++future_stamps_;
+    return;
+  }
   std::string error;
   std::optional<Eigen::Isometry2d> cam = mount(baseFrame(msg->robot_id), msg->header.frame_id, msg->header.stamp, &error);
   if (!cam) {
@@ -162,6 +173,7 @@ void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   const sensors::UwbCounters& c = uwb_->counters();
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
+  stat.add("stamped in the future (dropped)", future_stamps_);
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

@@ -52,12 +52,18 @@ std::vector<PersonBox> HogPersonDetector::detect(const cv::Mat& bgr) const {
     factor = static_cast<double>(options_.max_width) / bgr.cols;
   if (std::abs(factor - 1.0) > 1e-9)
     cv::resize(bgr, img, cv::Size(), factor, factor, factor < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
+  // An image smaller than the HOG window holds no person; OpenCV 4.6 crashes on it (bug #8793), so it is not
+  // passed on. Non-8-bit or non-3-channel input is refused the same way.
+  const cv::Size window = impl_->hog.winSize;
+  if (img.cols < window.width || img.rows < window.height || img.type() != CV_8UC3) return out;
   std::vector<cv::Rect> rects;
   std::vector<double> weights;
-  {
+  try {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     impl_->hog.detectMultiScale(img, rects, weights, options_.hit_threshold, cv::Size(8, 8), cv::Size(),
                                 options_.scale, 2.0, false);
+  } catch (const cv::Exception&) {
+    return out;  // OpenCV refused the image: no detections
   }
   for (std::size_t i = 0; i < rects.size(); ++i) {
     PersonBox b;

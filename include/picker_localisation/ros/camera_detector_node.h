@@ -5,6 +5,8 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
+
+#include "picker_localisation/ros/stamp_guard.h"
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
@@ -37,7 +39,8 @@ class CameraDetectorNode {
   ros::Time last_processed_;
   diagnostic_updater::Updater diagnostics_;
   std::size_t received_ = 0, processed_ = 0, dropped_stale_ = 0, dropped_rate_ = 0, dropped_no_info_ = 0,
-              bad_images_ = 0, boxes_ = 0;
+              bad_images_ = 0, boxes_ = 0, dropped_future_ = 0;
+  StampGuard stamp_guard_;  // future stamps, clock jumping back
   double last_processing_s_ = 0.0;
 };
 

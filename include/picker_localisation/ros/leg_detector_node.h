@@ -17,12 +17,17 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_vision/cloud3d_person_detector.h"
 #include "picker_localisation/sensors_vision/leg_pipeline.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
+
+// Empty when the cloud's data agrees with its metadata (sizes, x/y/z FLOAT32 fields inside point_step), else
+// the first problem (one line).
+std::string cloudProblem(const sensor_msgs::PointCloud2& cloud);
 
 class LegDetectorNode {
  public:
@@ -40,6 +45,9 @@ class LegDetectorNode {
   void publishPeople(const std::string& source_frame, const ros::Time& stamp,
                      const std::vector<sensors::PersonCandidate>& people);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  // False (counted, throttled warning) for a stamp too far ahead of the clock; resets the time state once when
+  // the clock jumped back.
+  bool acceptStamp(const ros::Time& stamp, const char* what);
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
@@ -57,7 +65,8 @@ class LegDetectorNode {
   sensor_msgs::CameraInfo::ConstPtr camera_info_;
   diagnostic_updater::Updater diagnostics_;
   std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
-              camera_frames_ = 0, fused_ = 0;
+              camera_frames_ = 0, fused_ = 0, future_stamps_ = 0, bad_clouds_ = 0, bad_detections_ = 0;
+  StampGuard stamp_guard_;
   ros::Time last_input_;
 };
 

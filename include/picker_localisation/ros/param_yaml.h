@@ -2,9 +2,15 @@
 // fromYaml() reader (TpfParams, nbs::PlannerConfig, ...).
 #pragma once
 
+#include <ros/console.h>
 #include <ros/node_handle.h>
+#include <ros/this_node.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 #include <yaml-cpp/yaml.h>
+
+#include <exception>
+#include <string>
+#include <vector>
 
 namespace picker_localisation {
 namespace ros_adapter {
@@ -14,6 +20,21 @@ namespace ros_adapter {
 YAML::Node toYaml(const XmlRpc::XmlRpcValue& value);
 // Every parameter under the node handle's namespace (a node's private ~ parameters) as one YAML map.
 YAML::Node paramsAsYaml(const ros::NodeHandle& nh);
+
+// A core options schema (Options::fromYaml(node, &unknown)) from a node's private parameters: one warning per
+// unknown key (naming the closest known one); on a bad value one FATAL line naming the key and false.
+template <class Options>
+bool loadOptions(const ros::NodeHandle& pnh, Options& out) {
+  try {
+    std::vector<std::string> unknown;
+    out = Options::fromYaml(paramsAsYaml(pnh), &unknown);
+    for (const auto& u : unknown) ROS_WARN("%s: %s", ros::this_node::getName().c_str(), u.c_str());
+    return true;
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
+    return false;
+  }
+}
 
 }  // namespace ros_adapter
 }  // namespace picker_localisation

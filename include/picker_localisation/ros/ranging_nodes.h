@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
@@ -60,7 +61,8 @@ class GnssIngestNode {
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t published_ = 0;
+  std::size_t published_ = 0, future_stamps_ = 0;
+  StampGuard stamp_guard_;
 };
 
 // rfid_ranging: RfidReading -> antenna pose from tf at the read's stamp -> RfidObservationModel.
@@ -84,7 +86,8 @@ class RfidRangingNode {
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t tf_failures_ = 0, published_ = 0;
+  std::size_t tf_failures_ = 0, published_ = 0, future_stamps_ = 0;
+  StampGuard stamp_guard_;
 };
 
 // uwb_ranging: UwbRange (+ optional camera BearingDetectionArray) -> anchors / cameras in base_link and the
@@ -118,7 +121,8 @@ class UwbRangingNode {
   ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
+  std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0, future_stamps_ = 0;
+  StampGuard stamp_guard_;
   bool have_range_ = false;
   double newest_stamp_ = 0.0;     // newest accepted-or-not range stamp (s)
   ros::WallTime last_arrival_;    // wall time of the last range message

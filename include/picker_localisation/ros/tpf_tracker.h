@@ -33,6 +33,7 @@
 #include <string>
 
 #include "picker_localisation/core/stamp_ordered_buffer.h"
+#include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
 namespace picker_localisation {
@@ -70,6 +71,7 @@ class TpfTracker {
   bool reset(picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res);
   bool whatIf(picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res);
   void publish();
+  static constexpr int kMaxPredictionsPerCall = 100;  // a longer silence is bridged by one prediction
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   std::string picker_id_, frame_id_;
@@ -83,7 +85,12 @@ class TpfTracker {
   double ordering_latency_ = 0.5;
   diagnostic_updater::Updater diagnostics_;
   double prediction_period_ = 0.0;
-  std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0;
+  std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0,
+                future_stamps_ = 0;
+  StampGuard stamp_guard_;
+  // The clock jumped back (bag loop, simulator restart): the belief and the waiting observations are dropped
+  // so the next observation initialises the filter again (its stamps would all be "too old" otherwise).
+  void checkClockJump();
   std::uint64_t last_reported_problems_ = 0, last_diag_received_ = 0;
   ros::WallTime last_diag_time_;
   std::string last_problem_;

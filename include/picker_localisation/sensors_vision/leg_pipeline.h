@@ -99,6 +99,11 @@ class LegPipeline {
                                        double stamp, const std::string& robot_id);
 
   std::size_t liveTracks() const;
+  // Forgets every track and the camera promotion state (the clock jumped back).
+  void reset() {
+    trackers_.clear();
+    fusion_.reset();
+  }
   std::size_t cameraConfirmed() const { return camera_confirmed_; }
 
  private:

@@ -1,0 +1,45 @@
+// Time sanity for nodes that keep time state (issue 17): stamps implausibly far in the future are rejected
+// instead of adopted (one would block every later message), and a backwards jump of the node's clock (a bag
+// replayed with -l, a simulator restart) is detected once so the node can reset its time state. Differences
+// are taken in double seconds: ros::Duration throws ("out of dual 32-bit range") for a stamp decades away.
+#pragma once
+
+#include <ros/time.h>
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+// Seconds from `from` to `to` (never throws).
+inline double secondsBetween(const ros::Time& from, const ros::Time& to) {
+  return to.toSec() - from.toSec();
+}
+
+class StampGuard {
+ public:
+  explicit StampGuard(double max_future = 10.0, double jump_tolerance = 1.0)
+      : max_future_(max_future), jump_tolerance_(jump_tolerance) {}
+  // True when `stamp` lies more than max_future s after the node's clock. Before the clock runs (sim time
+  // 0) nothing is too far.
+  bool tooFarInFuture(const ros::Time& stamp) const {
+    const double now = ros::Time::now().toSec();
+    return now > 0.0 && max_future_ > 0.0 && stamp.toSec() - now > max_future_;
+  }
+  // True once per backwards jump of the node's clock by more than jump_tolerance s since the last call.
+  bool clockJumpedBack() {
+    const double now = ros::Time::now().toSec();
+    const bool jumped = now + jump_tolerance_ < last_now_;
+    last_now_ = now;
+    if (jumped) ++jumps_;
+    return jumped;
+  }
+  std::size_t jumps() const { return jumps_; }
+  double maxFuture() const { return max_future_; }
+
+ private:
+  double max_future_, jump_tolerance_;
+  double last_now_ = 0.0;
+  std::size_t jumps_ = 0;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation
