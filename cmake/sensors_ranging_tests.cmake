@@ -7,3 +7,9 @@ add_rostest_gtest(test_rfid_ranging_node test/rfid_ranging.test test/test_rfid_r
 target_link_libraries(test_rfid_ranging_node picker_localisation_ros)
 add_rostest_gtest(test_uwb_ranging_node test/uwb_ranging.test test/test_uwb_ranging_node.cpp)
 target_link_libraries(test_uwb_ranging_node picker_localisation_ros)
+# rostest: the clock jumps back; gnss_ingest and tpf_tracker reset their time state and beliefs continue.
+if(TARGET tpf_tracker)
+  add_rostest_gtest(test_clock_jump test/clock_jump.test test/test_clock_jump.cpp)
+  target_link_libraries(test_clock_jump picker_localisation_ros picker_localisation_sensors_ranging)
+  add_dependencies(test_clock_jump gnss_ingest tpf_tracker)
+endif()

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "picker_localisation/eval/experiment.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
@@ -62,8 +64,10 @@ fs::path tempDir(const std::string& name) {
 }  // namespace
 
 TEST(Experiment, MethodsAndScenarios) {
-  EXPECT_EQ(allMethodNames().size(), 10u);
+  EXPECT_EQ(allMethodNames().size(), 12u);
   EXPECT_TRUE(isKnownMethod("ukf_metric"));
+  EXPECT_TRUE(isKnownMethod("raw_fix"));
+  EXPECT_TRUE(isKnownMethod("gnss_tpf"));
   EXPECT_FALSE(isKnownMethod("bogus"));
   EXPECT_EQ(methodUnavailableReason("bogus"), "unknown method");
   EXPECT_THROW(parseScenario("double"), std::invalid_argument);
@@ -174,5 +178,33 @@ TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
     ++checked;
   }
   EXPECT_GT(checked, 60u);  // 3 pickers, ~30 samples each (after the first fix)
+}
+#endif
+
+#ifdef PL_TEST_HAVE_SIM
+TEST(Experiment, RawFixIsTheNodeNearestTheLatestFix) {
+  // With every GNSS error off but a 0.1 m white noise, the raw fix's node is within half a node spacing (~1.5 m)
+  // of the truth most of the time: the baseline measures the fixes, not a filter.
+  const std::string sim = (fs::path(testing::TempDir()) / "pl_sim_white.yaml").string();
+  {
+    YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
+    y["gnss"]["offset_max"] = 0.0;
+    y["gnss"]["drift_std"] = 0.0;
+    y["gnss"]["blackout_mean_interval"] = 0.0;
+    std::ofstream(sim) << y;
+  }
+  auto map = std::make_shared<const topology::TopologicalMap>(
+      topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
+  RunConfig rc;
+  rc.scenario = Scenario::kSingle;
+  rc.method = "raw_fix";
+  rc.seed = 2;
+  rc.duration = 60.0;
+  rc.sim_config = sim;
+  const RunResult r = runOnce(map, rc);
+  ASSERT_GE(r.samples.size(), 50u);
+  std::size_t close = 0;
+  for (const auto& s : r.samples) close += s.euclidean < 2.0 ? 1 : 0;
+  EXPECT_GT(static_cast<double>(close) / r.samples.size(), 0.9);
 }
 #endif

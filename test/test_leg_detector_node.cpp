@@ -15,8 +15,10 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 
 #include <geometry_msgs/PoseArray.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 
@@ -212,20 +214,36 @@ TEST(LegDetectorNode, PointCloudPerson) {
     bad.row_step = bad.width * bad.point_step;
     bad.data.resize(12);
     pub.publish(bad);
+    waitFor([] { return false; }, 0.3);  // the node queues 2 clouds
     bad = cloud;
     bad.header.stamp = ros::Time::now();
     bad.point_step = 0;
     pub.publish(bad);
+    waitFor([] { return false; }, 0.3);  // the node queues 2 clouds
     bad = cloud;
     bad.header.stamp = ros::Time::now();
     for (auto& f : bad.fields) f.datatype = sensor_msgs::PointField::FLOAT64;
     pub.publish(bad);
+    waitFor([] { return false; }, 0.3);  // the node queues 2 clouds
     bad = cloud;
     bad.header.stamp = ros::Time(4102444800.0);  // 2100: ros::Duration threw in the tf lookup
     pub.publish(bad);
+    waitFor([] { return false; }, 0.3);  // the node queues 2 clouds
     waitFor([] { return false; }, 0.5);
     EXPECT_TRUE(rec.people.empty());
     EXPECT_EQ(picker_localisation::ros_adapter::cloudProblem(cloud), "");
+    // Counted in diagnostics (published at 1 Hz).
+    std::map<std::string, std::string> diag;
+    auto diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+          for (const auto& st : m->status)
+            if (st.name.find("leg detector") != std::string::npos)
+              for (const auto& kv : st.values) diag[kv.key] = kv.value;
+        });
+    ASSERT_TRUE(waitFor([&] { return diag.count("malformed clouds (dropped)") > 0 &&
+                                     diag["malformed clouds (dropped)"] == "3"; }, 5.0))
+        << diag["malformed clouds (dropped)"];
+    EXPECT_EQ(diag["stamps in the future (dropped)"], "1");
   }
   for (int k = 0; k < 5; ++k) {
     cloud.header.stamp = ros::Time::now();

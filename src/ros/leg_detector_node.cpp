@@ -89,6 +89,8 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   diagnostics_.setHardwareID(robot_id_.empty() ? "leg_detector" : robot_id_);
   diagnostics_.add("leg detector", this, &LegDetectorNode::diagnose);
+  // The updater publishes only when update() is called (it was never called: nothing on /diagnostics).
+  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
   ok_ = true;
   ROS_INFO("%s: %zu scan topic(s), model %s, fixed frame %s%s", ros::this_node::getName().c_str(),
            scan_topics.size(), model.c_str(), fixed_frame_.c_str(),

@@ -41,7 +41,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "map_file",
-        "map_timeout",      "frame_id",     "observation_topic", "topological_map"};
+        "map_timeout",      "frame_id",     "observation_topic", "topological_map", "max_future_stamp"};
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
   }
   return o;

@@ -1,0 +1,82 @@
+// rostest: /clock runs 100 -> 112 s with a fix per second, then jumps back to 10 s and runs on with fixes
+// stamped 10.. s. Before issue 17's fix gnss_ingest rejected every later fix as "not after the last accepted one"
+// and the tracker dropped every observation as too old, so beliefs stopped; now both reset once and beliefs
+// stamped after the jump appear.
+#include <gtest/gtest.h>
+#include <picker_localisation/PickerBelief.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/NavSatFix.h>
+
+#include <Eigen/Core>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+
+namespace {
+bool waitWall(const std::function<bool()>& done, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return done();
+}
+}  // namespace
+
+TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
+  ros::NodeHandle nh;
+  ros::Publisher clock = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
+  ros::Publisher fix = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 10);
+  std::vector<double> belief_stamps;
+  ros::Subscriber sub = nh.subscribe<picker_localisation::PickerBelief>(
+      "/pickers/picker_1/belief", 100,
+      [&](const picker_localisation::PickerBelief::ConstPtr& m) { belief_stamps.push_back(m->header.stamp.toSec()); });
+  ASSERT_TRUE(waitWall([&] { return fix.getNumSubscribers() > 0 && sub.getNumPublishers() > 0 &&
+                                    clock.getNumSubscribers() >= 2; }, 30.0));
+  const auto datum = picker_localisation::sensors::GeodeticDatum::load(std::string(PL_PACKAGE_DIR) +
+                                                                         "/config/datum.yaml");
+  auto run = [&](double t0, double t1) {
+    for (double t = t0; t <= t1 + 1e-9; t += 0.1) {
+      rosgraph_msgs::Clock c;
+      c.clock = ros::Time(t);
+      clock.publish(c);
+      if (std::abs(t - std::round(t)) < 1e-6) {  // one fix per second, walking along a Riseholme lane
+        const Eigen::Vector2d ll = datum.toLatLon(Eigen::Vector2d(16.0, -30.0 + 0.5 * (t - t0)));
+        sensor_msgs::NavSatFix f;
+        f.header.stamp = ros::Time(t);
+        f.header.frame_id = "gps";
+        f.latitude = ll.x();
+        f.longitude = ll.y();
+        f.altitude = 50.0;
+        f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
+        f.position_covariance = {1.0, 0, 0, 0, 1.0, 0, 0, 0, 4.0};
+        f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
+        fix.publish(f);
+      }
+      waitWall([] { return false; }, 0.02);
+    }
+  };
+  run(100.0, 112.0);
+  ASSERT_TRUE(waitWall([&] { return !belief_stamps.empty() && belief_stamps.back() >= 105.0; }, 10.0))
+      << belief_stamps.size() << " beliefs before the jump";
+  const std::size_t before = belief_stamps.size();
+  run(10.0, 25.0);  // the clock jumped back by 102 s
+  waitWall([] { return false; }, 1.0);
+  std::size_t after_jump = 0;
+  for (std::size_t i = before; i < belief_stamps.size(); ++i)
+    after_jump += (belief_stamps[i] >= 11.0 && belief_stamps[i] <= 26.0) ? 1 : 0;
+  EXPECT_GE(after_jump, 5u) << "beliefs stamped after the jump back: " << after_jump;
+  EXPECT_GE(belief_stamps.back(), 15.0);
+  EXPECT_LE(belief_stamps.back(), 26.0);
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_clock_jump");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
