@@ -14,18 +14,9 @@
 #include <vector>
 
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "ranging_rostest_util.h"
 
-namespace {
-bool waitWall(const std::function<bool()>& done, double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
-}
-}  // namespace
+using ranging_test::waitFor;
 
 TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
   ros::NodeHandle nh;
@@ -35,7 +26,7 @@ TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
   ros::Subscriber sub = nh.subscribe<picker_localisation::PickerBelief>(
       "/pickers/picker_1/belief", 100,
       [&](const picker_localisation::PickerBelief::ConstPtr& m) { belief_stamps.push_back(m->header.stamp.toSec()); });
-  ASSERT_TRUE(waitWall([&] { return fix.getNumSubscribers() > 0 && sub.getNumPublishers() > 0 &&
+  ASSERT_TRUE(waitFor([&] { return fix.getNumSubscribers() > 0 && sub.getNumPublishers() > 0 &&
                                     clock.getNumSubscribers() >= 2; }, 30.0));
   const auto datum = picker_localisation::sensors::GeodeticDatum::load(std::string(PL_PACKAGE_DIR) +
                                                                          "/config/datum.yaml");
@@ -45,27 +36,17 @@ TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
       c.clock = ros::Time(t);
       clock.publish(c);
       if (std::abs(t - std::round(t)) < 1e-6) {  // one fix per second, walking along a Riseholme lane
-        const Eigen::Vector2d ll = datum.toLatLon(Eigen::Vector2d(16.0, -30.0 + 0.5 * (t - t0)));
-        sensor_msgs::NavSatFix f;
-        f.header.stamp = ros::Time(t);
-        f.header.frame_id = "gps";
-        f.latitude = ll.x();
-        f.longitude = ll.y();
-        f.altitude = 50.0;
-        f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
-        f.position_covariance = {1.0, 0, 0, 0, 1.0, 0, 0, 0, 4.0};
-        f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
-        fix.publish(f);
+        fix.publish(ranging_test::fixAt(datum, Eigen::Vector2d(16.0, -30.0 + 0.5 * (t - t0)), ros::Time(t)));
       }
-      waitWall([] { return false; }, 0.02);
+      waitFor([] { return false; }, 0.02);
     }
   };
   run(100.0, 112.0);
-  ASSERT_TRUE(waitWall([&] { return !belief_stamps.empty() && belief_stamps.back() >= 105.0; }, 10.0))
+  ASSERT_TRUE(waitFor([&] { return !belief_stamps.empty() && belief_stamps.back() >= 105.0; }, 10.0))
       << belief_stamps.size() << " beliefs before the jump";
   const std::size_t before = belief_stamps.size();
   run(10.0, 25.0);  // the clock jumped back by 102 s
-  waitWall([] { return false; }, 1.0);
+  waitFor([] { return false; }, 1.0);
   std::size_t after_jump = 0;
   for (std::size_t i = before; i < belief_stamps.size(); ++i)
     after_jump += (belief_stamps[i] >= 11.0 && belief_stamps[i] <= 26.0) ? 1 : 0;

@@ -11,21 +11,7 @@
 
 using picker_localisation::sensors::GeodeticDatum;
 
-namespace {
-sensor_msgs::NavSatFix fixAt(const GeodeticDatum& datum, const Eigen::Vector2d& p, const ros::Time& stamp) {
-  sensor_msgs::NavSatFix f;
-  f.header.stamp = stamp;
-  f.header.frame_id = "gps";
-  const Eigen::Vector2d ll = datum.toLatLon(p);
-  f.latitude = ll.x();
-  f.longitude = ll.y();
-  f.altitude = 50.0;
-  f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
-  f.position_covariance = {1.0, 0, 0, 0, 1.0, 0, 0, 0, 4.0};
-  f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
-  return f;
-}
-}  // namespace
+using ranging_test::fixAt;
 
 TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   ros::NodeHandle nh;
