@@ -60,7 +60,6 @@ void CameraDetectorNode::imageCallback(const sensor_msgs::Image::ConstPtr& msg) 
   ++received_;
   const ros::Time stamp = msg->header.stamp;
   if (stamp_guard_.tooFarInFuture(stamp)) {
-    ++dropped_future_;
     ROS_WARN_THROTTLE(10.0, "%s: frame stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       ros::this_node::getName().c_str(), stamp.toSec(), stamp_guard_.maxFuture());
     return;
@@ -150,7 +149,7 @@ void CameraDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& s
   stat.add("dropped: rate limit", dropped_rate_);
   stat.add("dropped: no camera info", dropped_no_info_);
   stat.add("dropped: bad encoding", bad_images_);
-  stat.add("dropped: stamp in the future", dropped_future_);
+  stat.add("dropped: stamp in the future", stamp_guard_.futureStamps());
   stat.add("boxes published", boxes_);
   stat.add("last processing time (s)", last_processing_s_);
 }

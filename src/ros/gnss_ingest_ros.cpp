@@ -62,7 +62,6 @@ void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::siz
   }
   sensors::GnssIngest& g = ingest_[i];
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
-    ++future_stamps_;
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix stamped %.3f is more than %.1f s ahead of the clock: rejected",
                       g.pickerId().c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
@@ -82,7 +81,7 @@ void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::siz
 void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   const double now = ros::Time::now().toSec();
   std::size_t blackout = 0, rejected = 0;
-  stat.add("fixes stamped in the future (rejected)", future_stamps_);
+  stat.add("fixes stamped in the future (rejected)", stamp_guard_.futureStamps());
   stat.add("clock jumps back", stamp_guard_.jumps());
   for (const sensors::GnssIngest& g : ingest_) {
     const sensors::GnssCounters& c = g.counters();

@@ -119,7 +119,6 @@ bool LegDetectorNode::acceptStamp(const ros::Time& stamp, const char* what) {
     last_detections_.reset();
   }
   if (!stamp_guard_.tooFarInFuture(stamp)) return true;
-  ++future_stamps_;
   ROS_WARN_THROTTLE(5.0, "%s: %s stamped %.3f is more than %.1f s ahead of the clock: dropped",
                     ros::this_node::getName().c_str(), what, stamp.toSec(), stamp_guard_.maxFuture());
   return false;
@@ -255,7 +254,7 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("clouds", clouds_);
   stat.add("empty inputs", empty_scans_);
   stat.add("tf failures (dropped)", tf_failures_);
-  stat.add("stamps in the future (dropped)", future_stamps_);
+  stat.add("stamps in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("malformed clouds (dropped)", bad_clouds_);
   stat.add("non-finite camera detections (dropped)", bad_detections_);
   stat.add("clock jumps back", stamp_guard_.jumps());

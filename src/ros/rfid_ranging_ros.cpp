@@ -42,7 +42,6 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 
 void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {  // adopting it would reject every later read
-    ++future_stamps_;
     ROS_WARN_THROTTLE(5.0, "rfid_ranging: read stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
@@ -82,7 +81,7 @@ void RfidRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   const sensors::RfidCounters& c = model_->counters();
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
-  stat.add("stamped in the future (dropped)", future_stamps_);
+  stat.add("stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

@@ -225,7 +225,6 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
   checkClockJump();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     // Adopting it would make every later observation "too old" and start ~(stamp - now) / period predictions.
-    ++future_stamps_;
     ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       picker_id_.c_str(), msg->sensor.c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
@@ -362,7 +361,7 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   last_diag_time_ = now;
   last_diag_received_ = received_;
   stat.add("observations received", received_);
-  stat.add("observations stamped in the future (dropped)", future_stamps_);
+  stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("clock jumps back (belief reset)", stamp_guard_.jumps());
   stat.add("observations waiting for stamp order", ordering_.size());
   stat.add("ordering overflows", ordering_.forcedReleases());

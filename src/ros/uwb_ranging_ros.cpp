@@ -88,7 +88,6 @@ std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, 
 
 void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
-    ++future_stamps_;
     ROS_WARN_THROTTLE(5.0, "uwb_ranging: range stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
@@ -129,10 +128,7 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
 }
 
 void UwbRangingNode::onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
-  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
-    ++future_stamps_;
-    return;
-  }
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;  // counted by the guard
   std::string error;
   std::optional<Eigen::Isometry2d> cam = mount(baseFrame(msg->robot_id), msg->header.frame_id, msg->header.stamp, &error);
   if (!cam) {
@@ -173,7 +169,7 @@ void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   const sensors::UwbCounters& c = uwb_->counters();
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
-  stat.add("stamped in the future (dropped)", future_stamps_);
+  stat.add("stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

@@ -151,6 +151,22 @@ struct TopologicalParticleFilter::MotionGraph {
     }
   }
 
+  // A particle jumped from `from` to `to`, leaving its lane: 1 + the index of a lane-change path of `from` whose
+  // first step is that jump (the jump chose the side; when both sides share the first node, one at random), or
+  // 0 when there is none or the path already ends at `to`.
+  std::uint32_t exitPathStartingWith(NodeIndex from, NodeIndex to, std::mt19937_64& rng) const {
+    if (exit_offsets.empty()) return 0;
+    const std::uint32_t begin = exit_offsets[from], end = exit_offsets[from + 1];
+    auto starts_with_to = [&](std::uint32_t k) { return lane_paths[exit_paths[k]][1] == to; };
+    std::uint32_t found = 0;
+    for (std::uint32_t k = begin; k < end; ++k) found += starts_with_to(k) ? 1 : 0;
+    if (found == 0) return 0;
+    std::uint32_t skip = found > 1 ? static_cast<std::uint32_t>(rng() % found) : 0;
+    for (std::uint32_t k = begin; k < end; ++k)
+      if (starts_with_to(k) && skip-- == 0) return lane_paths[exit_paths[k]].back() == to ? 0 : exit_paths[k] + 1;
+    return 0;
+  }
+
   MotionGraph(const topology::TopologicalMap& map, bool directed, bool lane_change, int max_hops) {
     const std::size_t n = map.numNodes();
     offsets.resize(n + 1, 0);
@@ -388,13 +404,29 @@ bool TopologicalParticleFilter::predictTo(double stamp) {
 }
 
 void TopologicalParticleFilter::initialise(const core::Observation& obs) {
-  // Eq. 1: q ~ L / sum L (uniform over the whole map when the observation does not identify the picker),
-  // v ~ N(mu_init, sigma^2_init) per component, tau ~ U(tau^-_init, tau^+_init).
   const std::size_t n = params_.num_particles;
   particles_.resize(n);
   resampled_.resize(n);
   weights_.resize(n);
   spare_bits_.assign(n, 0u);
+  redraw(obs, n);
+}
+
+void TopologicalParticleFilter::reinitialisePart(const core::Observation& obs, double fraction) {
+  // Departure from Alg. 1 l. 6 (reinit_fraction < 1): only every (1/fraction)-th particle is drawn again from
+  // Eq. 1, the rest keep the belief. A contradicting observation that is right wins within a few updates (the
+  // redrawn particles carry its weight); one that is wrong (an RFID ring 5-8 m from the antenna, a biased
+  // fix) no longer scatters the whole belief.
+  const double n = static_cast<double>(particles_.size());
+  redraw(obs, std::max<std::size_t>(1, static_cast<std::size_t>(fraction * n)));
+}
+
+void TopologicalParticleFilter::redraw(const core::Observation& obs, std::size_t count) {
+  // Eq. 1 for `count` particles spread evenly over the set (every particle when count = size): q ~ L / sum L
+  // (uniform over the whole map when the observation does not identify the picker), v ~ N(mu_init,
+  // sigma^2_init) per component, tau ~ U(tau^-_init, tau^+_init). Resets p_rj (Alg. 1 l. 8). L sums to > 0
+  // (validateObservation).
+  const std::size_t n = particles_.size();
   std::normal_distribution<double> vel(params_.velocity_init_mean, std::sqrt(params_.velocity_init_variance));
   std::vector<double> cumulative;
   if (obs.identifying) {
@@ -403,7 +435,8 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
     for (double l : obs.likelihood) cumulative.push_back(c += l);
   }
   const double span = params_.dwell_init_max - params_.dwell_init_min;
-  for (Particle& p : particles_) {
+  for (std::size_t j = 0; j < count; ++j) {
+    Particle& p = particles_[(j * n) / count];
     if (obs.identifying) {
       const double u = uniform01(rng_) * cumulative.back();
       std::size_t k = static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) -
@@ -419,35 +452,6 @@ void TopologicalParticleFilter::initialise(const core::Observation& obs) {
     p.lane_change = 0;
   }
   unconnected_p_ = params_.unconnected_jump_probability;
-}
-
-void TopologicalParticleFilter::reinitialisePart(const core::Observation& obs, double fraction) {
-  // Departure from Alg. 1 l. 6 (reinit_fraction < 1): only every (1/fraction)-th particle is drawn again from
-  // Eq. 1, the rest keep the belief. A contradicting observation that is right wins within a few updates (the
-  // redrawn particles carry its weight); one that is wrong (an RFID ring 5-8 m from the antenna, a biased
-  // fix) no longer scatters the whole belief.
-  const std::size_t n = particles_.size();
-  const std::size_t count = std::max<std::size_t>(1, static_cast<std::size_t>(fraction * static_cast<double>(n)));
-  std::vector<double> cumulative;
-  cumulative.reserve(obs.likelihood.size());
-  double c = 0.0;
-  for (double l : obs.likelihood) cumulative.push_back(c += l);
-  if (!(c > 0.0)) return;
-  std::normal_distribution<double> vel(params_.velocity_init_mean, std::sqrt(params_.velocity_init_variance));
-  const double span = params_.dwell_init_max - params_.dwell_init_min;
-  for (std::size_t j = 0; j < count; ++j) {
-    Particle& p = particles_[(j * n) / count];
-    const double u = uniform01(rng_) * c;
-    const std::size_t k = std::min<std::size_t>(
-        static_cast<std::size_t>(std::upper_bound(cumulative.begin(), cumulative.end(), u) - cumulative.begin()),
-        cumulative.size() - 1);
-    p.node = obs.nodes[k];
-    p.vx = static_cast<float>(vel(rng_));
-    p.vy = static_cast<float>(vel(rng_));
-    p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
-    p.lane_change = 0;
-  }
-  unconnected_p_ = params_.unconnected_jump_probability;  // Alg. 1 l. 8
 }
 
 void TopologicalParticleFilter::predict(double dt) {
@@ -592,29 +596,8 @@ void TopologicalParticleFilter::predict(double dt) {
         // Followed the path (ends one node inside the new lane) or left it.
         const auto& path = g.lane_paths[p.lane_change - 1];
         if (arc.target != path_next || path.back() == arc.target) p.lane_change = 0;
-      } else if (g.exit_offsets.size() > from + 1 && g.exit_offsets[from] != g.exit_offsets[from + 1] &&
-                 map_->lane(arc.target) != map_->lane(from)) {
-        // Left the lane at an end: take a lane-change path that starts with this jump (the side is chosen by
-        // the jump; when both sides share the first node, one at random).
-        std::uint32_t first = 0, found = 0;
-        for (std::uint32_t k = g.exit_offsets[from]; k < g.exit_offsets[from + 1]; ++k)
-          if (g.lane_paths[g.exit_paths[k]][1] == arc.target) {
-            if (found == 0) first = k;
-            ++found;
-          }
-        if (found > 0) {
-          std::uint32_t pick = first;
-          if (found > 1) {
-            std::uint32_t skip = static_cast<std::uint32_t>(rng_() % found);
-            for (std::uint32_t k = first; k < g.exit_offsets[from + 1]; ++k)
-              if (g.lane_paths[g.exit_paths[k]][1] == arc.target && skip-- == 0) {
-                pick = k;
-                break;
-              }
-          }
-          const auto& path = g.lane_paths[g.exit_paths[pick]];
-          p.lane_change = path.back() == arc.target ? 0 : g.exit_paths[pick] + 1;
-        }
+      } else if (map_->lane(arc.target) != map_->lane(from)) {
+        p.lane_change = g.exitPathStartingWith(from, arc.target, rng_);  // left the lane at an end?
       }
     }
     if (count[p.node] == 0.0) touched_.push_back(p.node);

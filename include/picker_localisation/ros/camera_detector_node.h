@@ -40,7 +40,7 @@ class CameraDetectorNode {
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;  // calls diagnostics_.update() at 1 Hz (ROS time)
   std::size_t received_ = 0, processed_ = 0, dropped_stale_ = 0, dropped_rate_ = 0, dropped_no_info_ = 0,
-              bad_images_ = 0, boxes_ = 0, dropped_future_ = 0;
+              bad_images_ = 0, boxes_ = 0;
   StampGuard stamp_guard_;  // future stamps, clock jumping back
   double last_processing_s_ = 0.0;
 };

@@ -66,7 +66,7 @@ class LegDetectorNode {
   diagnostic_updater::Updater diagnostics_;
   ros::Timer diagnostics_timer_;  // calls diagnostics_.update() at 1 Hz (ROS time)
   std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
-              camera_frames_ = 0, fused_ = 0, future_stamps_ = 0, bad_clouds_ = 0, bad_detections_ = 0;
+              camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0, bad_detections_ = 0;
   StampGuard stamp_guard_;
   ros::Time last_input_;
 };

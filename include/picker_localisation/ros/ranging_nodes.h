@@ -61,7 +61,7 @@ class GnssIngestNode {
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t published_ = 0, future_stamps_ = 0;
+  std::size_t published_ = 0;
   StampGuard stamp_guard_;
 };
 
@@ -86,7 +86,7 @@ class RfidRangingNode {
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t tf_failures_ = 0, published_ = 0, future_stamps_ = 0;
+  std::size_t tf_failures_ = 0, published_ = 0;
   StampGuard stamp_guard_;
 };
 
@@ -121,7 +121,7 @@ class UwbRangingNode {
   ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0, future_stamps_ = 0;
+  std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
   StampGuard stamp_guard_;
   bool have_range_ = false;
   double newest_stamp_ = 0.0;     // newest accepted-or-not range stamp (s)

@@ -18,11 +18,13 @@ class StampGuard {
  public:
   explicit StampGuard(double max_future = 10.0, double jump_tolerance = 1.0)
       : max_future_(max_future), jump_tolerance_(jump_tolerance) {}
-  // True when `stamp` lies more than max_future s after the node's clock. Before the clock runs (sim time
-  // 0) nothing is too far.
-  bool tooFarInFuture(const ros::Time& stamp) const {
+  // True (and counted) when `stamp` lies more than max_future s after the node's clock. Before the clock runs
+  // (sim time 0) nothing is too far.
+  bool tooFarInFuture(const ros::Time& stamp) {
     const double now = ros::Time::now().toSec();
-    return now > 0.0 && max_future_ > 0.0 && stamp.toSec() - now > max_future_;
+    const bool far = now > 0.0 && max_future_ > 0.0 && stamp.toSec() - now > max_future_;
+    if (far) ++future_stamps_;
+    return far;
   }
   // True once per backwards jump of the node's clock by more than jump_tolerance s since the last call.
   bool clockJumpedBack() {
@@ -33,12 +35,13 @@ class StampGuard {
     return jumped;
   }
   std::size_t jumps() const { return jumps_; }
+  std::size_t futureStamps() const { return future_stamps_; }  // messages tooFarInFuture() refused
   double maxFuture() const { return max_future_; }
 
  private:
   double max_future_, jump_tolerance_;
   double last_now_ = 0.0;
-  std::size_t jumps_ = 0;
+  std::size_t jumps_ = 0, future_stamps_ = 0;
 };
 
 }  // namespace ros_adapter

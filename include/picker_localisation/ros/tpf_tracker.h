@@ -85,8 +85,7 @@ class TpfTracker {
   double ordering_latency_ = 0.5;
   diagnostic_updater::Updater diagnostics_;
   double prediction_period_ = 0.0;
-  std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0,
-                future_stamps_ = 0;
+  std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0;
   StampGuard stamp_guard_;
   // The clock jumped back (bag loop, simulator restart): the belief and the waiting observations are dropped
   // so the next observation initialises the filter again (its stamps would all be "too old" otherwise).

@@ -174,6 +174,7 @@ class TopologicalParticleFilter {
   UpdateResult reject(UpdateStatus status, std::string reason);
   void initialise(const core::Observation& obs);
   void reinitialisePart(const core::Observation& obs, double fraction);
+  void redraw(const core::Observation& obs, std::size_t count);  // Eq. 1 for `count` evenly spread particles
   void predict(double dt);
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
