@@ -68,8 +68,8 @@
 namespace picker_localisation {
 namespace tpf {
 
-// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter). 16 bytes: single
-// precision is ample for speeds (m/s) and dwell times (s) and halves the memory traffic of resampling.
+// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter). 20 bytes with the
+// lane-change path index: single precision is ample for speeds (m/s) and dwell times (s) and halves the memory traffic of resampling.
 struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
