@@ -2,7 +2,9 @@
 # ROS-free core library (namespace picker_localisation::sensors).
 add_library(picker_localisation_sensors_ranging
   src/sensors_ranging/geodetic_datum.cpp
+  src/sensors_ranging/gnss_bias.cpp
   src/sensors_ranging/gnss_ingest.cpp
+  src/sensors_ranging/picker_association.cpp
   src/sensors_ranging/rfid_observation_model.cpp
   src/sensors_ranging/range_histogram_filter.cpp
   src/sensors_ranging/uwb_ranging.cpp)

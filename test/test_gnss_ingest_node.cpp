@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 #include <sensor_msgs/NavSatFix.h>
 
+#include <picker_localisation/GnssBias.h>
+
 #include <cmath>
 
+#include "picker_localisation/core/observation.h"
+#include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/topology/map_io.h"
 #include "ranging_rostest_util.h"
 
 using picker_localisation::sensors::GeodeticDatum;
@@ -63,10 +68,78 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   EXPECT_NEAR(c.obs[1].velocity.x, 0.5, 1e-3);
   // Diagnostics: rejections by kind (no_fix/not_finite/negative_cov/out_of_order/jump).
   ASSERT_TRUE(ranging_test::waitFor(
-      [&] { return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"] == "1/1/1/2/0"; }, 5.0))
+      [&] {
+        return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"] == "1/1/1/2/0" &&
+               c.diag["picker_1 accepted"] == "2";
+      },
+      5.0))
       << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"];
   EXPECT_EQ(c.diag["picker_1 accepted"], "2");  // the fix after the 2100 one was accepted: nothing blocked
   EXPECT_EQ(c.diag["fixes stamped in the future (rejected)"], "1");
+}
+
+// Issue "Find the lane": anonymous people near a picker's fix become that picker's observations, and the
+// sightings teach gnss_ingest the unit's bias, which later fixes have removed.
+TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
+  namespace pl = picker_localisation;
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "GNSS ingestion");
+  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  const pl::topology::TopologicalMap map =
+      pl::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  std::vector<pl::GnssBias> bias;
+  ros::Subscriber bias_sub = nh.subscribe<pl::GnssBias>(
+      "/pickers/picker_3/gnss_bias", 20, [&](const pl::GnssBias::ConstPtr& m) { bias.push_back(*m); });
+  ros::Publisher fixes = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_3/fix", 20);
+  ros::Publisher people = nh.advertise<pl::Observation>("/person_observations", 20);
+  ASSERT_TRUE(ranging_test::waitFor([&] {
+    return fixes.getNumSubscribers() > 0 && people.getNumSubscribers() > 0 && bias_sub.getNumPublishers() > 0;
+  }, 30.0));
+  const Eigen::Vector2d truth(15.0, -2.0), offset(3.0, 2.0);  // picker_3's unit reads 3.6 m off
+  auto person = [&](const Eigen::Vector2d& at, const ros::Time& stamp) {
+    pl::core::Observation o;
+    o.stamp = stamp.toSec();
+    o.sensor = "lidar";
+    o.robot_id = "robot_1";
+    o.position = at;
+    o.position_covariance = Eigen::Matrix2d::Identity() * 0.09;
+    pl::core::setGaussianLikelihood(o, map, at, o.position_covariance);
+    return pl::ros_adapter::toMsg(o, map);
+  };
+  const ros::Time t0 = ros::Time::now();
+  for (int k = 0; k < 6; ++k) {
+    const ros::Time t = t0 + ros::Duration(k);
+    fixes.publish(fixAt(datum, truth + offset, t));
+    people.publish(person(truth, t + ros::Duration(0.1)));
+    ranging_test::spinFor(0.05);
+  }
+  people.publish(person(Eigen::Vector2d(30.0, -35.0), t0 + ros::Duration(6.0)));  // nobody's: stays anonymous
+  fixes.publish(fixAt(datum, truth + offset, t0 + ros::Duration(7.0)));
+  auto lidar = [&](bool identifying) {
+    std::size_t n = 0;
+    for (const auto& o : c.obs) n += o.sensor == "lidar" && o.identifying == identifying;
+    return n;
+  };
+  ASSERT_TRUE(ranging_test::waitFor([&] { return lidar(true) >= 6 && lidar(false) >= 1 && bias.size() >= 7; }, 10.0))
+      << lidar(true) << " identified, " << lidar(false) << " anonymous, " << bias.size() << " bias messages";
+  for (const auto& o : c.obs)
+    if (o.sensor == "lidar" && o.identifying) EXPECT_EQ(o.picker_id, "picker_3");
+  EXPECT_FALSE(bias.front().estimated);  // the first fix came before any sighting
+  const pl::GnssBias& last = bias.back();
+  EXPECT_TRUE(last.estimated);
+  EXPECT_NEAR(last.bias.x, offset.x(), 0.5);
+  EXPECT_NEAR(last.bias.y, offset.y(), 0.5);
+  EXPECT_GE(last.sightings, 5u);
+  EXPECT_LT(last.covariance[0], 1.0);
+  // The last fix is published with the bias removed.
+  const pl::Observation* fix = nullptr;
+  for (const auto& o : c.obs)
+    if (o.sensor == "gnss" && o.picker_id == "picker_3") fix = &o;
+  ASSERT_NE(fix, nullptr);
+  EXPECT_NEAR(fix->position.x, truth.x(), 0.5);
+  EXPECT_NEAR(fix->position.y, truth.y(), 0.5);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["picker_3 bias sightings accepted/refused"].rfind("6/", 0) == 0; }, 5.0))
+      << c.diag["picker_3 bias sightings accepted/refused"];
 }
 
 int main(int argc, char** argv) {

@@ -41,7 +41,7 @@ TEST(LegPipelineParity, NodeEqualsRunnerPipeline) {
   ros::NodeHandle nh;
   std::vector<pl::Observation> received;
   auto sub = nh.subscribe<pl::Observation>(
-      "/observations", 1000, [&](const pl::Observation::ConstPtr& m) { received.push_back(*m); });
+      "/person_observations", 1000, [&](const pl::Observation::ConstPtr& m) { received.push_back(*m); });
   ros::Publisher pubs[2] = {nh.advertise<sensor_msgs::LaserScan>(kLasers[0].topic, 100),
                             nh.advertise<sensor_msgs::LaserScan>(kLasers[1].topic, 100)};
   tf2_ros::StaticTransformBroadcaster tfb;

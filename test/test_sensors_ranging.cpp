@@ -9,7 +9,9 @@
 #include <stdexcept>
 
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/sensors_ranging/gnss_bias.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/picker_association.h"
 #include "picker_localisation/sensors_ranging/range_histogram_filter.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
@@ -811,4 +813,209 @@ TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
   plain.process(read);
   read.stamp = 3.0;
   EXPECT_NEAR(likelihoodAt(*plain.process(read).observation, nodeAt(*map, 0, 0)), p0, 1e-9);
+}
+
+// ---------------------------------------------------------------------------------------------------------
+// GNSS bias estimate (offset + Ornstein-Uhlenbeck drift, 4-state Kalman) and identity for anonymous people
+
+TEST(GnssBiasEstimator, PriorIsStationaryUntilTheFirstSighting) {
+  GnssBiasOptions o;  // offset_std 2, drift_std 2.5
+  GnssBiasEstimator b(o);
+  EXPECT_FALSE(b.sighted());
+  EXPECT_FALSE(b.usable(100.0));
+  EXPECT_NEAR(b.bias(100.0).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(b.covariance(100.0)(0, 0), 4.0 + 6.25, 1e-9);
+  EXPECT_NEAR(b.covariance(100.0)(0, 1), 0.0, 1e-12);
+}
+
+TEST(GnssBiasEstimator, ConvergesOnAConstantBiasThenRelaxesToTheOffset) {
+  GnssBiasEstimator b;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  const Eigen::Vector2d truth(2.0, -3.0);
+  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.09;
+  for (int k = 0; k < 30; ++k) {
+    const BiasUpdate u = b.update(k, truth + Eigen::Vector2d(noise(rng), noise(rng)), R);
+    ASSERT_TRUE(u.accepted) << u.reason;
+  }
+  EXPECT_EQ(b.sightings(), 30u);
+  EXPECT_TRUE(b.usable(29.0));
+  EXPECT_LT((b.bias(29.0) - truth).norm(), 0.25);
+  EXPECT_LT(b.covariance(29.0)(0, 0), 0.05);
+  // Long after the last sighting: the drift part decays (exp(-dt/tau)), the variance tends to
+  // P_c + drift_std^2 (bounded, never below the fresh value), and the estimate is no longer usable.
+  const double late = 29.0 + 5000.0;
+  EXPECT_GT(b.covariance(late)(0, 0), b.covariance(29.0 + 60.0)(0, 0));
+  EXPECT_GT(b.covariance(late)(0, 0), 6.0);
+  EXPECT_LT(b.covariance(late)(0, 0), 6.25 + 4.0);
+  EXPECT_FALSE(b.usable(late));
+  // A sighting 20 m from a converged estimate fails the gate and changes nothing; an older one is refused.
+  const Eigen::Vector2d before = b.bias(30.0);
+  BiasUpdate bad = b.update(30.0, truth + Eigen::Vector2d(20.0, 0.0), R);
+  EXPECT_FALSE(bad.accepted);
+  EXPECT_NE(bad.reason.find("gate"), std::string::npos) << bad.reason;
+  EXPECT_FALSE(b.update(10.0, truth, R).accepted);
+  EXPECT_FALSE(b.update(31.0, Eigen::Vector2d(kNaN, 0.0), R).accepted);
+  EXPECT_NEAR((b.bias(30.0) - before).norm(), 0.0, 1e-12);
+  EXPECT_EQ(b.refused(), 3u);
+}
+
+TEST(GnssIngest, SightingsRemoveTheBiasFromLaterFixes) {
+  GnssFixture fx;
+  GnssIngest gnss("picker_1", fx.map, fx.datum);
+  const Eigen::Vector2d offset(3.0, 2.0), truth(-4.0, 2.0);
+  GnssResult r = gnss.process(fx.fixAt(1.0, truth + offset, 9.0));
+  ASSERT_TRUE(r.accepted());
+  EXPECT_FALSE(r.bias_corrected);  // no sighting yet: as without the estimate
+  EXPECT_NEAR((*r.observation->position - (truth + offset)).norm(), 0.0, 1e-6);
+  // Sightings pair with the fix nearest in time (at most bias_pairing_gap 2 s away).
+  EXPECT_FALSE(gnss.addSighting(5.0, truth, Eigen::Matrix2d::Identity() * 0.09).accepted);
+  for (int k = 2; k <= 10; ++k) {
+    ASSERT_TRUE(gnss.process(fx.fixAt(k, truth + offset, 9.0)).accepted());
+    const BiasUpdate u = gnss.addSighting(k + 0.2, truth, Eigen::Matrix2d::Identity() * 0.09);
+    ASSERT_TRUE(u.accepted) << u.reason;
+  }
+  r = gnss.process(fx.fixAt(11.0, truth + offset, 9.0));
+  ASSERT_TRUE(r.accepted());
+  EXPECT_TRUE(r.bias_corrected);
+  EXPECT_NEAR((r.position - (truth + offset)).norm(), 0.0, 1e-6);  // the raw fix is still reported
+  EXPECT_LT((*r.observation->position - truth).norm(), 0.3);
+  EXPECT_LT(r.observation->position_covariance(0, 0), 1.0);
+  EXPECT_EQ(likelihoodAt(*r.observation, nodeAt(*fx.map, truth.x(), truth.y())),
+            *std::max_element(r.observation->likelihood.begin(), r.observation->likelihood.end()));
+  const GnssIngest::Prediction p = gnss.predictPosition(11.5, 0.7, 30.0);
+  ASSERT_TRUE(p.valid);
+  EXPECT_LT((p.mean - truth).norm(), 0.3);
+  EXPECT_FALSE(gnss.predictPosition(50.0, 0.7, 30.0).valid);
+  // With the estimate switched off the fixes are used as they come.
+  GnssIngestOptions off;
+  off.bias.enabled = false;
+  GnssIngest raw("picker_1", fx.map, fx.datum, off);
+  ASSERT_TRUE(raw.process(fx.fixAt(1.0, truth + offset, 9.0)).accepted());
+  EXPECT_FALSE(raw.addSighting(1.0, truth, Eigen::Matrix2d::Identity() * 0.09).accepted);
+  EXPECT_FALSE(raw.process(fx.fixAt(2.0, truth + offset, 9.0)).bias_corrected);
+}
+
+namespace {
+// Three pickers in neighbouring lanes 1.5 m apart (y = 0, 1.5, 3), each with a fix at its true position.
+struct ThreeLanes {
+  GnssFixture fx;
+  std::vector<GnssIngest> ingest;
+  std::vector<GnssIngest*> pickers;
+  ThreeLanes() {
+    for (int i = 0; i < 3; ++i) ingest.emplace_back("picker_" + std::to_string(i + 1), fx.map, fx.datum);
+    for (auto& g : ingest) pickers.push_back(&g);
+  }
+  void fixes(double t, const std::vector<Eigen::Vector2d>& at) {
+    for (std::size_t i = 0; i < 3; ++i) ASSERT_TRUE(ingest[i].process(fx.fixAt(t, at[i], 9.0)).accepted());
+  }
+  core::Observation person(double t, const Eigen::Vector2d& p) const {
+    core::Observation o;
+    o.stamp = t;
+    o.sensor = "lidar";
+    o.position = p;
+    o.position_covariance = Eigen::Matrix2d::Identity() * 0.09;
+    core::setGaussianLikelihood(o, *fx.map, p, o.position_covariance);
+    return o;
+  }
+};
+}  // namespace
+
+TEST(PickerAssociation, ClearDetectionsIdentifyAmbiguousOnesStayAnonymous) {
+  ThreeLanes f;
+  PickerAssociationOptions o;
+  // Fix-only (no beliefs). Pickers far apart: a detection at picker 2's fix is picker 2.
+  f.fixes(1.0, {{-15.0, 0.0}, {0.0, 1.5}, {15.0, 3.0}});
+  AssociationResult a = associatePerson(f.person(1.2, {0.3, 1.2}), f.pickers, {}, *f.fx.map, o);
+  EXPECT_EQ(a.picker, 1);
+  EXPECT_TRUE(a.observation.identifying);
+  EXPECT_EQ(a.observation.picker_id, "picker_2");
+  EXPECT_GE(a.probabilities[1], 0.9);
+  EXPECT_TRUE(a.bias.accepted) << a.bias.reason;
+  EXPECT_TRUE(f.ingest[1].bias().sighted());
+  EXPECT_FALSE(f.ingest[0].bias().sighted());
+  // Far from everybody: clutter, anonymous.
+  a = associatePerson(f.person(1.3, {0.0, -15.0}), f.pickers, {}, *f.fx.map, o);
+  EXPECT_EQ(a.picker, -1);
+  EXPECT_FALSE(a.observation.identifying);
+  EXPECT_GT(a.clutter_probability, 0.9);
+
+  // Three pickers side by side in neighbouring lanes, biases unknown: nobody may be named.
+  ThreeLanes g;
+  g.fixes(1.0, {{0.0, 0.0}, {0.0, 1.5}, {0.0, 3.0}});
+  for (double y : {0.0, 1.5, 3.0}) {
+    a = associatePerson(g.person(1.1, {0.0, y}), g.pickers, {}, *g.fx.map, o);
+    EXPECT_EQ(a.picker, -1) << "y " << y;
+    EXPECT_FALSE(a.observation.identifying);
+  }
+  // A belief that is sure (e.g. after an RFID read) breaks the tie for its picker.
+  const std::vector<NodeIndex> sure = {nodeAt(*g.fx.map, 0.0, 3.0)};
+  const std::vector<double> one = {1.0};
+  std::vector<NodeIndex> spread;
+  std::vector<double> spread_mass;
+  for (int x = -10; x <= 10; ++x)
+    for (int y = -5; y <= 5; ++y) {
+      spread.push_back(nodeAt(*g.fx.map, x, y));
+      spread_mass.push_back(1.0 / 231.0);
+    }
+  std::vector<BeliefView> beliefs = {{&spread, &spread_mass, 1.0}, {&spread, &spread_mass, 1.0}, {&sure, &one, -100.0}};
+  // A stale belief is not used.
+  EXPECT_EQ(associatePerson(g.person(1.1, {0.0, 3.0}), g.pickers, beliefs, *g.fx.map, o).picker, -1);
+  beliefs[2].stamp = 1.0;
+  a = associatePerson(g.person(1.1, {0.0, 3.0}), g.pickers, beliefs, *g.fx.map, o);
+  EXPECT_EQ(a.picker, 2);
+  EXPECT_GT(a.probabilities[2], 5.0 * a.probabilities[1]);
+  EXPECT_TRUE(g.ingest[2].bias().sighted());
+  // Once picker 3's bias is known its corrected fix is sharp: the next detection there is picker 3 without
+  // help from the belief, and one a lane away (picker 2's) is not given to picker 3.
+  a = associatePerson(g.person(1.2, {0.0, 3.1}), g.pickers, {}, *g.fx.map, o);
+  EXPECT_EQ(a.picker, 2);
+  a = associatePerson(g.person(1.2, {0.0, 1.5}), g.pickers, {}, *g.fx.map, o);
+  EXPECT_NE(a.picker, 2);
+
+  // The belief history hands out the newest belief stamped at or before the lagged time.
+  BeliefHistory h;
+  h.push(1.0, sure, one);
+  h.push(2.0, spread, spread_mass);
+  h.push(1.5, sure, one);  // older than the newest: ignored
+  EXPECT_EQ(h.size(), 2u);
+  EXPECT_FALSE(h.atOrBefore(0.5).valid());
+  EXPECT_EQ(h.atOrBefore(1.9).nodes->size(), 1u);
+  EXPECT_EQ(h.atOrBefore(2.0).nodes->size(), spread.size());
+  const std::vector<BeliefView> lagged = beliefViews({h}, 3.5, o);  // lag 2 s: the belief of 1.0
+  ASSERT_EQ(lagged.size(), 1u);
+  EXPECT_DOUBLE_EQ(lagged[0].stamp, 1.0);
+
+  // Identifying observations, observations without a position and association switched off pass unchanged.
+  core::Observation id = f.person(1.4, {0.0, 1.5});
+  id.identifying = true;
+  id.picker_id = "picker_3";
+  EXPECT_EQ(associatePerson(id, f.pickers, {}, *f.fx.map, o).observation.picker_id, "picker_3");
+  core::Observation no_pos = f.person(1.4, {0.0, 1.5});
+  no_pos.position.reset();
+  EXPECT_EQ(associatePerson(no_pos, f.pickers, {}, *f.fx.map, o).picker, -1);
+  PickerAssociationOptions off = o;
+  off.enabled = false;
+  EXPECT_EQ(associatePerson(f.person(1.5, {0.0, 1.5}), f.pickers, {}, *f.fx.map, off).picker, -1);
+}
+
+TEST(FrontEndOptions, BiasAndAssociationKeys) {
+  std::vector<std::string> unknown;
+  const GnssIngestOptions g = GnssIngestOptions::fromYaml(
+      YAML::Load("{bias_drift_tau: 120.0, association_min_probability: 0.95, estimate_bias: false, "
+                 "bias_ofset_std: 1}"),
+      &unknown);
+  EXPECT_DOUBLE_EQ(g.bias.drift_tau, 120.0);
+  EXPECT_DOUBLE_EQ(g.association.min_probability, 0.95);
+  EXPECT_FALSE(g.bias.enabled);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_NE(unknown[0].find("did you mean 'bias_offset_std'"), std::string::npos) << unknown[0];
+  try {
+    GnssIngestOptions::fromYaml(YAML::Load("{association_min_probability: 0.3}"));
+    ADD_FAILURE() << "accepted association_min_probability 0.3";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("association_min_probability = 0.3"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{bias_drift_tau: 0}")), std::runtime_error);
+  EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{bias_residual_std: -1}")), std::runtime_error);
 }

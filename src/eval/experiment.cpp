@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <iomanip>
 #include <map>
 #include <mutex>
@@ -33,6 +34,7 @@
 #endif
 #ifdef PL_HAVE_RANGING
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/picker_association.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #endif
 #ifdef PL_HAVE_VISION
@@ -259,6 +261,8 @@ struct PickerTrack {
 #endif
   std::unique_ptr<sensors::GnssIngest> gnss;
   NodeIndex raw_fix_node = topology::kInvalidNode;  // raw_fix: the node nearest the latest accepted fix
+  Eigen::Vector2d true_gnss_error{std::nan(""), std::nan("")};  // scoring only: the simulator's error of the
+                                                               // latest fix (never reaches an estimator)
 };
 
 }  // namespace
@@ -320,6 +324,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag});
   }
   const core::PickerRegistry registry(registry_entries);
+  // What gnss_ingest keeps of the trackers' published beliefs (the association reads them with a lag).
+  std::vector<sensors::BeliefHistory> belief_history(n);
+  std::vector<sensors::GnssIngest*> ingests;
+  for (auto& t : tracks) ingests.push_back(t.gnss.get());
   sensors::RfidObservationModel rfid_model(
       registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
@@ -347,6 +355,15 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
           map, params, sim::deriveSeed(config.tracker_seed ? config.tracker_seed : config.seed, 1000 + i));
   }
 #endif
+  auto publishBelief = [&](const PickerTrack& t) {
+#ifdef PL_HAVE_TPF
+    if (!t.tpf->initialised()) return;
+    const tpf::Belief& b = t.tpf->belief();
+    belief_history[static_cast<std::size_t>(&t - tracks.data())].push(b.stamp, b.nodes, b.masses);
+#else
+    (void)t;
+#endif
+  };
   auto toTracker = [&](const core::Observation& obs) {
 #ifdef PL_HAVE_TPF
     for (auto& t : tracks) {
@@ -354,6 +371,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
       if (t.tpf) {
         t.tpf->update(obs);
         ++result.observations;
+        publishBelief(t);
       }
     }
 #else
@@ -404,10 +422,13 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
       if (e.kind == 0) {
         const sim::GnssFix& f = out.gnss[e.index];
         PickerTrack& t = tracks.at(f.picker_index);
+        if (f.error.allFinite()) t.true_gnss_error = f.error;
         const sensors::GnssResult r = t.gnss->process(toIngestFix(f));
         if (!r.accepted()) continue;
         if (spec.tracker == Tracker::kRawFix) {
           t.raw_fix_node = map->nearestNode(r.position);
+        } else if (spec.tracker == Tracker::kUkf && r.bias_corrected) {
+          ukf.addGnss(f.stamp, t.id, *r.observation->position, r.observation->position_covariance);
         } else if (spec.tracker == Tracker::kUkf) {
           Eigen::Matrix2d enu;
           enu << f.position_covariance[0], f.position_covariance[1], f.position_covariance[3],
@@ -450,14 +471,28 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
             Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
         const std::vector<sensors::TrackedPerson> tracked =
             legs->processScan(s.robot_id + "/" + s.frame, s.stamp, scan, fixed_from_sensor);
+        result.lidar_detections += tracked.size();
+        // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's
+        // bias-corrected fix and tracker belief.
+        const std::vector<sensors::BeliefView> beliefs =
+            sensors::beliefViews(belief_history, s.stamp, gnss_options.association);
         std::vector<Eigen::Vector2d> people;
-        for (const auto& t : tracked) people.push_back(t.position);
-        result.lidar_detections += people.size();
-        if (spec.tracker == Tracker::kUkf) {
-          ukf.addDetections(s.stamp, people);
-        } else {
-          for (const auto& t : tracked) toTracker(sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id));
+        for (const auto& t : tracked) {
+          const sensors::AssociationResult a = sensors::associatePerson(
+              sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id), ingests, beliefs, *map,
+              gnss_options.association);
+          if (a.picker >= 0) ++result.identified_detections;
+          if (a.bias.accepted) ++result.bias_sightings;
+          if (spec.tracker == Tracker::kUkf) {
+            if (a.picker >= 0)
+              ukf.addGnss(s.stamp, a.observation.picker_id, t.position, a.observation.position_covariance);
+            else
+              people.push_back(t.position);
+          } else {
+            toTracker(a.observation);
+          }
         }
+        if (spec.tracker == Tracker::kUkf && !people.empty()) ukf.addDetections(s.stamp, people);
 #endif
       }
     }
@@ -465,8 +500,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     const double now = simulator.time();
 #ifdef PL_HAVE_TPF
     for (auto& t : tracks)  // periodic prediction when no observation arrives (Table I: 0.25 Hz)
-      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period)
+      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period) {
         t.tpf->predictTo(now);
+        publishBelief(t);
+      }
 #endif
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
     if (planner && (simulator.robot(0).atGoal() || now - last_plan >= replan_period)) {
@@ -490,6 +527,17 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         if (est == topology::kInvalidNode) continue;  // no estimate yet (before the first observation)
         result.samples.push_back(
             computeError(*map, est, simulator.pickerPose(i).position(), next_sample, tracks[i].id));
+        if (tracks[i].true_gnss_error.allFinite()) {
+          const sensors::GnssBiasEstimator& b = tracks[i].gnss->bias();
+          BiasSample bs;
+          bs.sighting_age = b.sighted() ? next_sample - b.lastSighting() : std::numeric_limits<double>::infinity();
+          bs.residual = (tracks[i].true_gnss_error -
+                         (b.usable(next_sample) ? b.bias(next_sample) : Eigen::Vector2d::Zero()))
+                            .norm();
+          bs.lane_applicable = result.samples.back().lane_applicable;
+          bs.in_true_lane = result.samples.back().in_true_lane;
+          result.bias_samples.push_back(bs);
+        }
       }
       next_sample += config.sample_period;
     }
@@ -503,6 +551,45 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap>, const RunConf
                            " unavailable: " + methodUnavailableReason(config.method, config));
 }
 #endif
+
+namespace {
+
+// The bias estimate's residual and the right-lane share by age of the last sighting, over all runs.
+void writeBiasByAge(const std::string& path, const std::vector<RunResult>& runs, std::ostream& log) {
+  const std::vector<double> edges = {0.0, 10.0, 30.0, 60.0, 120.0, std::numeric_limits<double>::infinity()};
+  const std::vector<std::string> names = {"0-10", "10-30", "30-60", "60-120", ">120", "never"};
+  std::vector<double> residual(names.size(), 0.0);
+  std::vector<std::size_t> count(names.size(), 0), lane(names.size(), 0), right(names.size(), 0);
+  for (const RunResult& r : runs)
+    for (const BiasSample& b : r.bias_samples) {
+      std::size_t k = names.size() - 1;
+      for (std::size_t e = 0; e + 1 < edges.size(); ++e)
+        if (b.sighting_age >= edges[e] && b.sighting_age < edges[e + 1]) k = e;
+      residual[k] += b.residual;
+      ++count[k];
+      if (b.lane_applicable) {
+        ++lane[k];
+        if (b.in_true_lane) ++right[k];
+      }
+    }
+  std::ofstream out(path);
+  out << "sighting_age_s,samples,bias_residual_mean_m,right_lane_share\n";
+  log << "    by age of the last bias sighting (s: share of samples, residual m, right lane):";
+  std::size_t total = 0;
+  for (auto c : count) total += c;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const double res = count[k] ? residual[k] / count[k] : std::nan("");
+    const double share = lane[k] ? static_cast<double>(right[k]) / lane[k] : std::nan("");
+    out << names[k] << "," << count[k] << "," << res << "," << share << "\n";
+    if (count[k])
+      log << "  " << names[k] << ": " << std::setprecision(2) << std::fixed
+          << static_cast<double>(count[k]) / std::max<std::size_t>(1, total) << ", " << res << ", " << share
+          << std::defaultfloat;
+  }
+  log << "\n";
+}
+
+}  // namespace
 
 ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log) {
   const auto wall0 = std::chrono::steady_clock::now();
@@ -561,6 +648,7 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
                   runs[k].samples);
       samples.push_back(std::move(runs[k].samples));
     }
+    if (specOf(method).lidar) writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
     MethodSummary row = summariseMethod(method, samples);
     res.rows.push_back(row);
     res.series.push_back(binErrors(method, samples, 0.0, std::max(5.0, config.duration / 100.0)));

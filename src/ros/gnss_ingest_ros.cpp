@@ -1,5 +1,10 @@
+#include <visualization_msgs/MarkerArray.h>
+
 #include <cmath>
+#include <cstdio>
 #include <sstream>
+
+#include <picker_localisation/GnssBias.h>
 
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
@@ -35,17 +40,38 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   map_ = obtainMap(nh, pnh, map_timeout);
   if (!map_) return;
 
-  std::string topic;
+  options_ = o;
+  std::string topic, person_topic, belief_prefix, bias_prefix;
   pnh.param<std::string>("observation_topic", topic, "/observations");
+  pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
+  pnh.param<std::string>("belief_topic_prefix", belief_prefix, "/pickers");
+  pnh.param<std::string>("bias_topic_prefix", bias_prefix, "/pickers");
+  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
+  ordering_ = core::StampOrderedBuffer<Input>(std::max(0.0, ordering_latency_));
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  markers_pub_ = pnh.advertise<visualization_msgs::MarkerArray>("bias_markers", 2, true);
   for (const core::PickerConfig& p : registry.pickers()) {
     if (p.gnss_topic.empty()) continue;
     ingest_.emplace_back(p.id, map_, *datum, o);
+    beliefs_.emplace_back();
     const std::size_t i = ingest_.size() - 1;
     subs_.push_back(nh.subscribe<sensor_msgs::NavSatFix>(
         p.gnss_topic, 50, [this, i](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, i); }));
+    bias_pubs_.push_back(nh.advertise<picker_localisation::GnssBias>(bias_prefix + "/" + p.id + "/gnss_bias", 5, true));
+    if (o.association.enabled && o.association.belief_weight > 0.0)
+      subs_.push_back(nh.subscribe<picker_localisation::PickerBelief>(
+          belief_prefix + "/" + p.id + "/belief", 20,
+          [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(m, i); }));
     ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
   }
+  if (o.association.enabled && !person_topic.empty()) {
+    subs_.push_back(nh.subscribe<picker_localisation::Observation>(
+        person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
+    ROS_INFO("gnss_ingest: associating anonymous people from %s with the pickers", person_topic.c_str());
+  }
+  if (ordering_latency_ > 0.0)
+    ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
+                                     [this](const ros::TimerEvent&) { releaseOrdered(); });
   if (ingest_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
   updater_.setHardwareID("gnss_ingest");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
@@ -53,29 +79,181 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   ok_ = true;
 }
 
+bool GnssIngestNode::checkClock() {
+  if (!stamp_guard_.clockJumpedBack()) return false;
+  // A bag replayed with -l or a simulator restart: forget every picker's fix history, bias estimate, the
+  // beliefs and what waits for stamp order (else every later fix would be "not after the last accepted one").
+  ROS_WARN("gnss_ingest: the clock jumped back: fix histories, bias estimates and beliefs reset");
+  for (auto& ingest : ingest_) ingest = sensors::GnssIngest(ingest.pickerId(), map_, ingest.datum(), ingest.options());
+  for (auto& b : beliefs_) b.clear();
+  ordering_.clear();
+  return true;
+}
+
 void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t i) {
-  if (stamp_guard_.clockJumpedBack()) {
-    // A bag replayed with -l or a simulator restart: forget every picker's fix history (else every later fix
-    // would be "not after the last accepted one" until the new stamps overtake the old).
-    ROS_WARN("gnss_ingest: the clock jumped back: fix histories reset");
-    for (auto& ingest : ingest_) ingest = sensors::GnssIngest(ingest.pickerId(), map_, ingest.datum(), ingest.options());
-  }
-  sensors::GnssIngest& g = ingest_[i];
+  checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix stamped %.3f is more than %.1f s ahead of the clock: rejected",
-                      g.pickerId().c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+                      ingest_[i].pickerId().c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
   }
-  sensors::GnssResult r = g.process(gnssFixFromMsg(*msg));
+  Input in;
+  in.picker = i;
+  in.fix = gnssFixFromMsg(*msg);
+  if (ordering_latency_ <= 0.0 || !std::isfinite(in.fix.stamp)) {
+    processFix(i, in.fix);  // (a NaN stamp is rejected there with its reason)
+    return;
+  }
+  ordering_.push(in.fix.stamp, "fix|" + ingest_[i].pickerId(), std::move(in));
+}
+
+void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& msg) {
+  checkClock();
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: person observation stamped %.3f is more than %.1f s ahead of the clock",
+                      msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
+  std::size_t unknown = 0;
+  Input in;
+  in.is_fix = false;
+  in.person = fromMsg(*msg, *map_, &unknown);
+  const std::string problem = core::validateObservation(in.person, *map_);
+  if (!problem.empty() || unknown > 0) {
+    ++bad_people_;
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: person observation from %s dropped: %s", msg->robot_id.c_str(),
+                      problem.empty() ? "node names not in the map" : problem.c_str());
+    return;
+  }
+  if (msg->identifying) {  // already identified (e.g. by another associator): pass through
+    pub_.publish(*msg);
+    ++published_;
+    return;
+  }
+  if (ordering_latency_ <= 0.0) {
+    processPerson(in.person);
+    return;
+  }
+  std::ostringstream key;
+  key.precision(17);
+  key << "person|" << msg->robot_id << "|" << msg->position.x << "|" << msg->position.y;
+  ordering_.push(in.person.stamp, key.str(), std::move(in));
+}
+
+void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t i) {
+  std::vector<topology::NodeIndex> nodes;
+  std::vector<double> masses;
+  for (std::size_t k = 0; k < msg->nodes.size() && k < msg->masses.size(); ++k) {
+    const auto n = map_->index(msg->nodes[k]);
+    if (!n || !std::isfinite(msg->masses[k]) || msg->masses[k] < 0.0) continue;
+    nodes.push_back(*n);
+    masses.push_back(msg->masses[k]);
+  }
+  beliefs_[i].push(msg->header.stamp.toSec(), nodes, masses);
+}
+
+void GnssIngestNode::releaseOrdered() {
+  if (checkClock()) return;
+  for (auto& item : ordering_.release(ros::Time::now().toSec())) {
+    if (item.second.is_fix)
+      processFix(item.second.picker, item.second.fix);
+    else
+      processPerson(item.second.person);
+  }
+}
+
+void GnssIngestNode::processFix(std::size_t i, const sensors::GnssFix& fix) {
+  sensors::GnssIngest& g = ingest_[i];
+  sensors::GnssResult r = g.process(fix);
   if (!r.accepted()) {
-    ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(),
-                      msg->header.stamp.toSec(), sensors::toString(r.rejection), r.reason.c_str());
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(), fix.stamp,
+                      sensors::toString(r.rejection), r.reason.c_str());
     return;
   }
   if (r.blackout_ended > 0.0)
     ROS_INFO("gnss_ingest: %s: GNSS back after a %.1f s blackout", g.pickerId().c_str(), r.blackout_ended);
   pub_.publish(toMsg(*r.observation, *map_, frame_id_));
   ++published_;
+  publishBias(i, fix.stamp, r);
+}
+
+void GnssIngestNode::processPerson(const core::Observation& person) {
+  ++people_;
+  std::vector<sensors::GnssIngest*> pickers;
+  for (auto& g : ingest_) pickers.push_back(&g);
+  const sensors::AssociationResult a = sensors::associatePerson(
+      person, pickers, sensors::beliefViews(beliefs_, person.stamp, options_.association), *map_,
+      options_.association);
+  if (a.picker >= 0) {
+    ++identified_;
+    if (!a.bias.accepted)
+      ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
+                a.bias.reason.c_str());
+  }
+  pub_.publish(toMsg(a.observation, *map_, frame_id_));
+  ++published_;
+}
+
+void GnssIngestNode::publishBias(std::size_t i, double stamp, const sensors::GnssResult& r) {
+  const sensors::GnssIngest& g = ingest_[i];
+  const sensors::GnssBiasEstimator& b = g.bias();
+  const bool used = b.usable(stamp);
+  const Eigen::Vector2d bias = used ? b.bias(stamp) : Eigen::Vector2d::Zero();
+  const Eigen::Matrix2d cov = used ? b.covariance(stamp) : sensors::GnssBiasEstimator(options_.bias).covariance(stamp);
+  picker_localisation::GnssBias m;
+  m.header.stamp.fromSec(std::max(0.0, stamp));
+  m.header.frame_id = frame_id_;
+  m.picker_id = g.pickerId();
+  m.estimated = used;
+  m.bias.x = bias.x();
+  m.bias.y = bias.y();
+  m.covariance = {cov(0, 0), cov(0, 1), cov(1, 0), cov(1, 1)};
+  m.sighting_age = b.sighted() ? stamp - b.lastSighting() : -1.0;
+  m.sightings = static_cast<std::uint32_t>(b.sightings());
+  m.refused = static_cast<std::uint32_t>(b.refused());
+  bias_pubs_[i].publish(m);
+
+  if (markers_pub_.getNumSubscribers() == 0) return;
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker arrow;
+  arrow.header = m.header;
+  arrow.ns = "gnss_bias/" + g.pickerId();
+  arrow.id = 0;
+  arrow.type = visualization_msgs::Marker::ARROW;
+  arrow.action = used ? visualization_msgs::Marker::ADD : visualization_msgs::Marker::DELETE;
+  arrow.pose.orientation.w = 1.0;
+  arrow.scale.x = 0.1;  // shaft diameter
+  arrow.scale.y = 0.25;
+  arrow.scale.z = 0.3;
+  arrow.color.r = 1.0;
+  arrow.color.g = 0.5;
+  arrow.color.a = 0.9;
+  geometry_msgs::Point from, to;
+  from.x = r.position.x();
+  from.y = r.position.y();
+  to.x = r.position.x() - bias.x();
+  to.y = r.position.y() - bias.y();
+  arrow.points = {from, to};
+  markers.markers.push_back(arrow);
+  visualization_msgs::Marker text = arrow;
+  text.id = 1;
+  text.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+  text.action = visualization_msgs::Marker::ADD;
+  text.points.clear();
+  text.pose.position = from;
+  text.pose.position.z = 1.5;
+  text.scale.x = text.scale.y = 0;
+  text.scale.z = 0.4;
+  text.color.r = text.color.g = text.color.b = 1.0;
+  char buf[160];
+  if (used)
+    std::snprintf(buf, sizeof buf, "%s bias %.1f m +-%.1f (%.0f s)", g.pickerId().c_str(), bias.norm(),
+                  std::sqrt(0.5 * cov.trace()), m.sighting_age);
+  else
+    std::snprintf(buf, sizeof buf, "%s bias unknown", g.pickerId().c_str());
+  text.text = buf;
+  markers.markers.push_back(text);
+  markers_pub_.publish(markers);
 }
 
 void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -99,6 +277,15 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     rejected += c.received - c.accepted;
   }
   stat.add("published", published_);
+  stat.add("people received / identified / dropped", std::to_string(people_) + " / " + std::to_string(identified_) +
+                                                         " / " + std::to_string(bad_people_));
+  stat.add("waiting for stamp order", ordering_.size());
+  for (const sensors::GnssIngest& g : ingest_) {
+    const sensors::GnssBiasEstimator& b = g.bias();
+    stat.add(g.pickerId() + " bias sightings accepted/refused",
+             std::to_string(b.sightings()) + "/" + std::to_string(b.refused()));
+    stat.add(g.pickerId() + " bias age [s]", b.sighted() ? now - b.lastSighting() : -1.0);
+  }
   if (blackout > 0)
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%zu picker(s) in GNSS blackout", blackout);
   else if (rejected > 0)

@@ -34,14 +34,20 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
   count("max_nodes", o.max_nodes);
   count("velocity_window", o.velocity_window);
   count("jump_reset_count", o.jump_reset_count);
+  o.bias = GnssBiasOptions::fromYaml(y);
+  o.association = PickerAssociationOptions::fromYaml(y);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
   if (unknown) {
-    const std::vector<std::string> known = {
+    std::vector<std::string> known = {
         "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "map_file",
-        "map_timeout",      "frame_id",     "observation_topic", "topological_map", "max_future_stamp"};
+        "map_timeout",      "frame_id",     "observation_topic", "topological_map", "max_future_stamp",
+        "person_observation_topic", "belief_topic_prefix", "bias_topic_prefix", "markers_topic"};
+    known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
+    known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
+                 PickerAssociationOptions::yamlKeys().end());
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
   }
   return o;
@@ -65,6 +71,55 @@ std::string GnssIngestOptions::validate() const {
   if (!(max_speed > 0.0)) return bad("max_speed", max_speed, "> 0");
   if (!(jump_gate_sigmas >= 0.0)) return bad("jump_gate_sigmas", jump_gate_sigmas, ">= 0");
   if (!(blackout_timeout > 0.0)) return bad("blackout_timeout", blackout_timeout, "> 0");
+  std::string problem = bias.validate();
+  if (problem.empty()) problem = association.validate();
+  return problem;
+}
+
+PickerAssociationOptions PickerAssociationOptions::fromYaml(const YAML::Node& y) {
+  PickerAssociationOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "gnss_ingest";
+  core::readOption(y, c, "associate_people", o.enabled);
+  core::readOption(y, c, "association_clutter_density", o.clutter_density);
+  core::readOption(y, c, "association_min_probability", o.min_probability);
+  core::readOption(y, c, "association_belief_weight", o.belief_weight);
+  core::readOption(y, c, "association_belief_sigma", o.belief_sigma);
+  core::readOption(y, c, "association_max_fix_age", o.max_fix_age);
+  core::readOption(y, c, "association_speed", o.speed);
+  core::readOption(y, c, "association_max_belief_age", o.max_belief_age);
+  core::readOption(y, c, "association_belief_lag", o.belief_lag);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  return o;
+}
+
+const std::vector<std::string>& PickerAssociationOptions::yamlKeys() {
+  static const std::vector<std::string> keys = {
+      "associate_people",         "association_clutter_density", "association_min_probability",
+      "association_belief_weight", "association_belief_sigma",   "association_max_fix_age",
+      "association_speed",        "association_max_belief_age",  "association_belief_lag"};
+  return keys;
+}
+
+std::string PickerAssociationOptions::validate() const {
+  auto bad = [](const char* key, double v, const char* rule) {
+    std::ostringstream s;
+    s << key << " = " << v << ": must be " << rule;
+    return s.str();
+  };
+  if (!(clutter_density > 0.0) || !std::isfinite(clutter_density))
+    return bad("association_clutter_density", clutter_density, "finite and > 0");
+  if (!(min_probability > 0.5 && min_probability <= 1.0))
+    return bad("association_min_probability", min_probability, "in (0.5, 1]");
+  if (!(belief_weight >= 0.0 && belief_weight <= 1.0))
+    return bad("association_belief_weight", belief_weight, "in [0, 1]");
+  if (!(belief_sigma > 0.0) || !std::isfinite(belief_sigma))
+    return bad("association_belief_sigma", belief_sigma, "finite and > 0");
+  if (!(max_fix_age > 0.0)) return bad("association_max_fix_age", max_fix_age, "> 0");
+  if (!(speed >= 0.0) || !std::isfinite(speed)) return bad("association_speed", speed, "finite and >= 0");
+  if (!(max_belief_age > 0.0)) return bad("association_max_belief_age", max_belief_age, "> 0");
+  if (!(belief_lag >= 0.0) || !std::isfinite(belief_lag)) return bad("association_belief_lag", belief_lag, "finite and >= 0");
   return "";
 }
 
@@ -88,7 +143,11 @@ const char* toString(GnssRejection r) {
 
 GnssIngest::GnssIngest(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map,
                        GeodeticDatum datum, GnssIngestOptions options)
-    : picker_id_(std::move(picker_id)), map_(std::move(map)), datum_(std::move(datum)), options_(options) {
+    : picker_id_(std::move(picker_id)),
+      map_(std::move(map)),
+      datum_(std::move(datum)),
+      options_(options),
+      bias_(options_.bias) {
   if (!map_) throw std::invalid_argument("GnssIngest: no map");
 }
 
@@ -185,6 +244,8 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   last_ = Accepted{fix.stamp, p, c_map};
   window_.push_back(*last_);
   while (window_.size() > std::max<std::size_t>(options_.velocity_window, 1)) window_.pop_front();
+  recent_.push_back(*last_);
+  while (recent_.size() > kRecentFixes) recent_.pop_front();
   ++counters_.accepted;
 
   core::Observation obs;
@@ -196,13 +257,62 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   lo.cutoff_sigmas = options_.cutoff_sigmas;
   lo.min_sigma = options_.min_sigma;
   lo.max_nodes = options_.max_nodes;
-  core::setGaussianLikelihood(obs, *map_, p, c_map, lo);
+  if (bias_.usable(fix.stamp)) {
+    // Bias removed (seed 001 Sec. VI): the fix minus the estimate, with the estimate's own uncertainty in
+    // place of the unit's reported one (which is mostly the bias itself).
+    const double r2 = options_.bias.residual_std * options_.bias.residual_std;
+    lo.min_sigma = options_.bias.min_sigma;
+    const Eigen::Vector2d corrected = p - bias_.bias(fix.stamp);
+    obs.position = corrected;
+    obs.position_covariance = bias_.covariance(fix.stamp) + r2 * Eigen::Matrix2d::Identity();
+    result.bias_corrected = true;
+  } else {
+    obs.position = p;
+    obs.position_covariance = c_map;
+  }
+  core::setGaussianLikelihood(obs, *map_, *obs.position, obs.position_covariance, lo);
   if (options_.velocity_window >= 2 && window_.size() >= 2) {
     const double span = window_.back().stamp - window_.front().stamp;
     if (span > 0.0) obs.velocity = (window_.back().position - window_.front().position) / span;
   }
   result.observation = std::move(obs);
   return result;
+}
+
+BiasUpdate GnssIngest::addSighting(double stamp, const Eigen::Vector2d& position,
+                                   const Eigen::Matrix2d& covariance) {
+  BiasUpdate u;
+  if (!options_.bias.enabled) {
+    u.reason = "bias estimation is disabled";
+    return u;
+  }
+  const Accepted* nearest = nullptr;
+  for (const Accepted& f : recent_)
+    if (!nearest || std::abs(f.stamp - stamp) < std::abs(nearest->stamp - stamp)) nearest = &f;
+  if (!nearest || std::abs(nearest->stamp - stamp) > options_.bias.pairing_gap) {
+    u.reason = "no fix within bias_pairing_gap of the sighting";
+    return u;
+  }
+  const double gap = std::abs(nearest->stamp - stamp);
+  const double r = options_.bias.residual_std, m = options_.bias.pairing_speed * gap;
+  const Eigen::Matrix2d R = covariance + (r * r + m * m) * Eigen::Matrix2d::Identity();
+  return bias_.update(stamp, nearest->position - position, R);
+}
+
+GnssIngest::Prediction GnssIngest::predictPosition(double t, double speed, double max_age) const {
+  Prediction pr;
+  if (!last_ || std::abs(t - last_->stamp) > max_age) return pr;
+  pr.valid = true;
+  const double r = options_.bias.residual_std, m = speed * std::abs(t - last_->stamp);
+  // Before any sighting (or with the estimate disabled) the bias is unknown: its prior covariance.
+  const GnssBiasOptions& bo = options_.bias;
+  const bool corrected = bias_.usable(t);
+  pr.mean = corrected ? Eigen::Vector2d(last_->position - bias_.bias(t)) : last_->position;
+  const Eigen::Matrix2d bias_cov =
+      corrected ? bias_.covariance(t)
+                : Eigen::Matrix2d(Eigen::Matrix2d::Identity() * (bo.offset_std * bo.offset_std + bo.drift_std * bo.drift_std));
+  pr.covariance = bias_cov + (r * r + m * m) * Eigen::Matrix2d::Identity();
+  return pr;
 }
 
 }  // namespace sensors

@@ -71,10 +71,21 @@ std::vector<std::string> visionConfigFiles(const std::string& value);
 // "" when `method` can run in this build, else one line saying what is missing.
 std::string methodUnavailableReason(const std::string& method, const RunConfig& config = RunConfig());
 
+// One metric sample seen from the picker's GNSS bias estimate: how old its last sighting was and how far the
+// estimate is from the unit's true error (the simulator's, used for scoring only).
+struct BiasSample {
+  double sighting_age = 0.0;  // s since the last accepted sighting; +inf before the first
+  double residual = 0.0;      // m, |true error - bias estimate| (|true error| while the estimate is unused)
+  bool lane_applicable = false, in_true_lane = false;  // as the ErrorSample of the same instant
+};
+
 struct RunResult {
   std::vector<ErrorSample> samples;
+  std::vector<BiasSample> bias_samples;
   std::size_t observations = 0;  // observations given to trackers
   std::size_t lidar_detections = 0;
+  std::size_t identified_detections = 0;  // LiDAR people that the association gave to one picker
+  std::size_t bias_sightings = 0;         // of those, accepted by the picker's GNSS bias estimate
   double wall_seconds = 0.0;
 };
 

@@ -5,6 +5,8 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/BearingDetectionArray.h>
+#include <picker_localisation/Observation.h>
+#include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/RfidReading.h>
 #include <picker_localisation/UwbRange.h>
 #include <ros/ros.h>
@@ -19,8 +21,10 @@
 #include <vector>
 
 #include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/core/stamp_ordered_buffer.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
+#include "picker_localisation/sensors_ranging/picker_association.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
 
@@ -44,24 +48,50 @@ std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 
 // gnss_ingest: one NavSatFix subscription per picker (config/pickers.yaml gnss_topic).
+// It also gives identity to anonymous people: Observations from every robot's leg_detector on
+// ~person_observation_topic are associated with the pickers (sensors::associatePerson, against each picker's
+// bias-corrected fix and its tracker's belief from /pickers/<id>/belief); a clear association is published as
+// an identifying observation of that picker and is a sighting for its GNSS bias estimate, an ambiguous one is
+// published unchanged. Fixes and people are processed in stamp order (~ordering_latency), beliefs chosen by
+// stamp (association_belief_lag), so a replayed bag gives the same output twice. Publishes the bias per picker
+// (/pickers/<id>/gnss_bias, GnssBias) and rviz markers (~bias_markers: raw fix -> corrected fix).
 class GnssIngestNode {
  public:
   GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
   bool ok() const { return ok_; }
 
  private:
+  struct Input {
+    bool is_fix = true;
+    std::size_t picker = 0;
+    sensors::GnssFix fix;
+    core::Observation person;
+  };
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t picker);
+  void onPerson(const picker_localisation::Observation::ConstPtr& msg);
+  void onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t picker);
+  bool checkClock();
+  void releaseOrdered();
+  void processFix(std::size_t picker, const sensors::GnssFix& fix);
+  void processPerson(const core::Observation& person);
+  void publishBias(std::size_t picker, double stamp, const sensors::GnssResult& r);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   bool ok_ = false;
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::string frame_id_;
+  sensors::GnssIngestOptions options_;
   std::vector<sensors::GnssIngest> ingest_;
+  std::vector<sensors::BeliefHistory> beliefs_;
   std::vector<ros::Subscriber> subs_;
-  ros::Publisher pub_;
+  ros::Publisher pub_, markers_pub_;
+  std::vector<ros::Publisher> bias_pubs_;
+  core::StampOrderedBuffer<Input> ordering_;
+  double ordering_latency_ = 0.2;
+  ros::Timer ordering_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t published_ = 0;
+  std::size_t published_ = 0, people_ = 0, identified_ = 0, bad_people_ = 0;
   StampGuard stamp_guard_;
 };
 

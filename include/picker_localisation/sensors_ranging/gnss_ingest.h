@@ -16,6 +16,7 @@
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/sensors_ranging/gnss_bias.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
@@ -42,6 +43,28 @@ enum class GnssRejection {
 };
 const char* toString(GnssRejection r);
 
+// Identity for anonymous people detections (LiDAR legs, camera-fused legs): see picker_association.h. Keys
+// association_<name> (enabled: associate_people) of config/gnss_ingest.yaml.
+struct PickerAssociationOptions {
+  bool enabled = true;               // associate anonymous people observations with pickers
+  double clutter_density = 5e-4;     // 1/m^2, density of people detections that are no listed picker (false
+                                     // legs, other workers): the "nobody we track" hypothesis
+  double min_probability = 0.8;      // association probability at which a detection identifies its picker
+  double belief_weight = 0.5;        // share of the tracker's belief in the picker's predicted position
+                                     // (the rest: the bias-corrected fix); 0 = fix only
+  double belief_sigma = 1.0;         // m, spread of a belief node's mass around the node (half a node spacing
+                                     // plus the picker's offset from the lane centre line)
+  double max_fix_age = 30.0;         // s, an older fix does not predict the picker (belief only)
+  double speed = 0.7;                // m/s, picker speed that spreads the prediction with the fix's age
+  double belief_lag = 2.0;           // s, the belief used is the newest one stamped at least this long before
+                                     // the detection (>= the trackers' ordering latency: deterministic replay)
+  double max_belief_age = 10.0;      // s, an older belief (beyond the lag) is not used
+
+  static PickerAssociationOptions fromYaml(const YAML::Node& node);
+  static const std::vector<std::string>& yamlKeys();
+  std::string validate() const;
+};
+
 struct GnssIngestOptions {
   std::string sensor = "gnss";      // Observation::sensor
   double default_sigma = 3.0;       // m, per axis, used when covariance_type is UNKNOWN (0)
@@ -57,6 +80,8 @@ struct GnssIngestOptions {
   double jump_gate_sigmas = 5.0;    // gate in standard deviations (0 disables the gate)
   std::size_t jump_reset_count = 5;
   double blackout_timeout = 10.0;   // s without an accepted fix = blackout (velocity window restarts after it)
+  GnssBiasOptions bias;             // the device's bias estimate (gnss_bias.h), keys bias_*
+  PickerAssociationOptions association;  // identity of anonymous people detections, keys association_*
 
   // The keys of config/gnss_ingest.yaml (the gnss_ingest node's private parameters; node-only keys such as
   // topics are accepted and ignored). Missing keys keep the defaults; a bad value throws std::runtime_error
@@ -71,7 +96,8 @@ struct GnssResult {
   GnssRejection rejection = GnssRejection::kNone;
   std::string reason;                       // one line for the log when rejected
   std::optional<core::Observation> observation;  // set when accepted
-  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // map frame, m (when the lat/lon were usable)
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();  // raw fix, map frame, m (when the lat/lon were usable)
+  bool bias_corrected = false;              // the observation's likelihood is centred on position - bias
   double blackout_ended = 0.0;              // s, length of the blackout this fix ended (0: none)
   bool accepted() const { return rejection == GnssRejection::kNone; }
 };
@@ -92,6 +118,23 @@ class GnssIngest {
              GnssIngestOptions options = {});
 
   GnssResult process(const GnssFix& fix);
+
+  // A metric sighting of this picker (position, covariance, map frame) by an identifying sensor or an
+  // associated people detection at time `stamp`: pairs it with the raw fix nearest in time (within
+  // bias_pairing_gap) and updates the bias estimate with y = fix - position,
+  // R = cov + residual_std^2 I + (pairing_speed * gap)^2 I.
+  BiasUpdate addSighting(double stamp, const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance);
+
+  // Where the GNSS says the picker is at time t: the latest accepted fix minus the bias estimate, with
+  // covariance P_bias(t) + residual_std^2 I + (speed * age)^2 I (prior bias covariance before any sighting).
+  struct Prediction {
+    bool valid = false;  // false before the first fix or when the fix is older than max_age
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity();
+  };
+  Prediction predictPosition(double t, double speed, double max_age) const;
+  const GnssBiasEstimator& bias() const { return bias_; }
+
   // True when no fix was accepted within blackout_timeout before `now` (s; message / sim time). False before
   // the first accepted fix.
   bool inBlackout(double now) const;
@@ -104,6 +147,7 @@ class GnssIngest {
   const GnssIngestOptions& options() const { return options_; }
 
  private:
+  static constexpr std::size_t kRecentFixes = 10;
   struct Accepted {
     double stamp;
     Eigen::Vector2d position;
@@ -114,6 +158,8 @@ class GnssIngest {
   GeodeticDatum datum_;
   GnssIngestOptions options_;
   std::deque<Accepted> window_;     // last accepted fixes (newest at the back)
+  std::deque<Accepted> recent_;     // last raw fixes for pairing sightings (kept through blackouts)
+  GnssBiasEstimator bias_;
   std::optional<Accepted> last_;    // last accepted fix
   std::size_t consecutive_jumps_ = 0;
   GnssCounters counters_;

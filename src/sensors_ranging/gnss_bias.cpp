@@ -1,0 +1,148 @@
+#include "picker_localisation/sensors_ranging/gnss_bias.h"
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "picker_localisation/core/yaml_keys.h"
+
+namespace picker_localisation {
+namespace sensors {
+
+GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
+  GnssBiasOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "gnss_ingest";
+  core::readOption(y, c, "estimate_bias", o.enabled);
+  core::readOption(y, c, "bias_offset_std", o.offset_std);
+  core::readOption(y, c, "bias_drift_std", o.drift_std);
+  core::readOption(y, c, "bias_drift_tau", o.drift_tau);
+  core::readOption(y, c, "bias_residual_std", o.residual_std);
+  core::readOption(y, c, "bias_min_sigma", o.min_sigma);
+  core::readOption(y, c, "bias_pairing_gap", o.pairing_gap);
+  core::readOption(y, c, "bias_pairing_speed", o.pairing_speed);
+  core::readOption(y, c, "bias_gate_sigmas", o.gate_sigmas);
+  core::readOption(y, c, "bias_max_age", o.max_age);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  return o;
+}
+
+const std::vector<std::string>& GnssBiasOptions::yamlKeys() {
+  static const std::vector<std::string> keys = {
+      "estimate_bias",     "bias_offset_std",  "bias_drift_std",     "bias_drift_tau",   "bias_residual_std",
+      "bias_min_sigma",    "bias_pairing_gap", "bias_pairing_speed", "bias_gate_sigmas", "bias_max_age"};
+  return keys;
+}
+
+std::string GnssBiasOptions::validate() const {
+  auto bad = [](const char* key, double v, const char* rule) {
+    std::ostringstream s;
+    s << key << " = " << v << ": must be " << rule;
+    return s.str();
+  };
+  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  if (!(offset_std >= 0.0) || !std::isfinite(offset_std)) return bad("bias_offset_std", offset_std, "finite and >= 0");
+  if (!(drift_std >= 0.0) || !std::isfinite(drift_std)) return bad("bias_drift_std", drift_std, "finite and >= 0");
+  if (!(offset_std + drift_std > 0.0)) return bad("bias_offset_std", offset_std, "> 0 when bias_drift_std is 0");
+  if (!positive(drift_tau)) return bad("bias_drift_tau", drift_tau, "finite and > 0");
+  if (!positive(residual_std)) return bad("bias_residual_std", residual_std, "finite and > 0");
+  if (!positive(min_sigma)) return bad("bias_min_sigma", min_sigma, "finite and > 0");
+  if (!(pairing_gap >= 0.0) || !std::isfinite(pairing_gap)) return bad("bias_pairing_gap", pairing_gap, "finite and >= 0");
+  if (!(pairing_speed >= 0.0) || !std::isfinite(pairing_speed))
+    return bad("bias_pairing_speed", pairing_speed, "finite and >= 0");
+  if (!positive(gate_sigmas)) return bad("bias_gate_sigmas", gate_sigmas, "finite and > 0");
+  if (!(max_age > 0.0)) return bad("bias_max_age", max_age, "> 0");
+  return "";
+}
+
+GnssBiasEstimator::GnssBiasEstimator(GnssBiasOptions options) : options_(options) {
+  const std::string problem = options_.validate();
+  if (!problem.empty()) throw std::invalid_argument("GnssBiasEstimator: " + problem);
+  reset();
+}
+
+void GnssBiasEstimator::reset() {
+  x_.setZero();
+  P_.setZero();
+  P_.topLeftCorner<2, 2>() = Eigen::Matrix2d::Identity() * options_.offset_std * options_.offset_std;
+  P_.bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() * options_.drift_std * options_.drift_std;
+  last_ = 0.0;
+  sightings_ = refused_ = 0;
+}
+
+// Exact OU transition of the drift states; the offset states are constant.
+void GnssBiasEstimator::predicted(double t, Eigen::Matrix<double, 4, 1>& x, Eigen::Matrix4d& P) const {
+  x = x_;
+  P = P_;
+  if (!sighted() || !(t > last_)) return;  // before a sighting the prior is stationary
+  const double a = std::exp(-(t - last_) / options_.drift_tau);
+  Eigen::Matrix4d F = Eigen::Matrix4d::Identity();
+  F.bottomRightCorner<2, 2>() *= a;
+  Eigen::Matrix4d Q = Eigen::Matrix4d::Zero();
+  Q.bottomRightCorner<2, 2>() =
+      Eigen::Matrix2d::Identity() * options_.drift_std * options_.drift_std * (1.0 - a * a);
+  x = F * x;
+  P = F * P * F.transpose() + Q;
+}
+
+Eigen::Vector2d GnssBiasEstimator::bias(double t) const {
+  Eigen::Matrix<double, 4, 1> x;
+  Eigen::Matrix4d P;
+  predicted(t, x, P);
+  return x.head<2>() + x.tail<2>();  // b = c + d
+}
+
+Eigen::Matrix2d GnssBiasEstimator::covariance(double t) const {
+  Eigen::Matrix<double, 4, 1> x;
+  Eigen::Matrix4d P;
+  predicted(t, x, P);
+  // H P H^T with H = [I I].
+  return P.topLeftCorner<2, 2>() + P.bottomRightCorner<2, 2>() + P.topRightCorner<2, 2>() +
+         P.bottomLeftCorner<2, 2>();
+}
+
+bool GnssBiasEstimator::usable(double t) const {
+  return options_.enabled && sighted() && t - last_ <= options_.max_age;
+}
+
+BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const Eigen::Matrix2d& R) {
+  BiasUpdate u;
+  auto refuse = [&](const std::string& why) {
+    u.reason = why;
+    ++refused_;
+    return u;
+  };
+  if (!std::isfinite(t) || !y.allFinite() || !R.allFinite()) return refuse("sighting is NaN/Inf");
+  if (sighted() && t < last_) return refuse("sighting is older than the last one used");
+  Eigen::Matrix<double, 4, 1> x;
+  Eigen::Matrix4d P;
+  predicted(t, x, P);
+  Eigen::Matrix<double, 2, 4> H;
+  H << Eigen::Matrix2d::Identity(), Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d S = H * P * H.transpose() + 0.5 * (R + R.transpose());
+  if (!(S.determinant() > 0.0)) return refuse("innovation covariance is singular");
+  const Eigen::Matrix2d S_inv = S.inverse();
+  u.innovation = y - H * x;
+  u.mahalanobis = std::sqrt(std::max(0.0, u.innovation.dot(S_inv * u.innovation)));
+  if (u.mahalanobis > options_.gate_sigmas) {
+    std::ostringstream s;
+    s << "innovation " << u.innovation.norm() << " m fails the gate (Mahalanobis " << u.mahalanobis << " > "
+      << options_.gate_sigmas << ")";
+    return refuse(s.str());
+  }
+  const Eigen::Matrix<double, 4, 2> K = P * H.transpose() * S_inv;
+  x_ = x + K * u.innovation;
+  // Joseph form keeps P symmetric positive definite.
+  const Eigen::Matrix4d I_KH = Eigen::Matrix4d::Identity() - K * H;
+  P_ = I_KH * P * I_KH.transpose() + K * R * K.transpose();
+  last_ = t;
+  ++sightings_;
+  u.accepted = true;
+  return u;
+}
+
+}  // namespace sensors
+}  // namespace picker_localisation

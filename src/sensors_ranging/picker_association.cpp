@@ -1,0 +1,97 @@
+#include "picker_localisation/sensors_ranging/picker_association.h"
+
+#include <Eigen/LU>
+
+#include <cmath>
+
+namespace picker_localisation {
+namespace sensors {
+
+namespace {
+
+double gaussian(const Eigen::Vector2d& d, const Eigen::Matrix2d& S) {
+  const double det = S.determinant();
+  if (!(det > 0.0)) return 0.0;
+  return std::exp(-0.5 * d.dot(S.inverse() * d)) / (2.0 * M_PI * std::sqrt(det));
+}
+
+// b_i(z): the belief's node masses spread isotropically (sigma^2 I + R_z), beyond 4 sigma left out.
+double beliefDensity(const BeliefView& b, const topology::TopologicalMap& map, const Eigen::Vector2d& z,
+                     const Eigen::Matrix2d& R, double sigma) {
+  const Eigen::Matrix2d S = sigma * sigma * Eigen::Matrix2d::Identity() + R;
+  const double reach2 = 16.0 * S.trace();
+  double sum = 0.0;
+  for (std::size_t k = 0; k < b.nodes->size(); ++k) {
+    const Eigen::Vector2d d = z - map.position2d((*b.nodes)[k]);
+    if (d.squaredNorm() > reach2) continue;
+    sum += (*b.masses)[k] * gaussian(d, S);
+  }
+  return sum;
+}
+
+}  // namespace
+
+void BeliefHistory::push(double stamp, const std::vector<topology::NodeIndex>& nodes,
+                         const std::vector<double>& masses, double horizon) {
+  if (!std::isfinite(stamp) || nodes.size() != masses.size() || nodes.empty()) return;
+  if (!items_.empty() && stamp < items_.back().stamp) return;
+  if (!items_.empty() && stamp == items_.back().stamp) items_.pop_back();
+  items_.push_back({stamp, nodes, masses});
+  while (items_.size() > 1 && items_.front().stamp < stamp - horizon) items_.pop_front();
+}
+
+BeliefView BeliefHistory::atOrBefore(double t) const {
+  for (auto it = items_.rbegin(); it != items_.rend(); ++it)
+    if (it->stamp <= t) return {&it->nodes, &it->masses, it->stamp};
+  return {};
+}
+
+std::vector<BeliefView> beliefViews(const std::vector<BeliefHistory>& histories, double stamp,
+                                    const PickerAssociationOptions& options) {
+  std::vector<BeliefView> views;
+  for (const BeliefHistory& h : histories) views.push_back(h.atOrBefore(stamp - options.belief_lag));
+  return views;
+}
+
+AssociationResult associatePerson(const core::Observation& person, const std::vector<GnssIngest*>& pickers,
+                                  const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
+                                  const PickerAssociationOptions& o) {
+  AssociationResult r;
+  r.observation = person;
+  r.probabilities.assign(pickers.size(), 0.0);
+  if (!o.enabled || person.identifying || !person.position || !person.position->allFinite() ||
+      !person.position_covariance.allFinite())
+    return r;
+  const Eigen::Vector2d z = *person.position;
+  const Eigen::Matrix2d R = 0.5 * (person.position_covariance + person.position_covariance.transpose());
+  std::vector<double> l(pickers.size(), 0.0);
+  double total = 0.0;
+  for (std::size_t i = 0; i < pickers.size(); ++i) {
+    const GnssIngest::Prediction fix = pickers[i]->predictPosition(person.stamp, o.speed, o.max_fix_age);
+    const double g = fix.valid ? gaussian(z - fix.mean, fix.covariance + R) : 0.0;
+    const bool have_belief = i < beliefs.size() && beliefs[i].valid() &&
+                             std::abs(person.stamp - beliefs[i].stamp) <= o.max_belief_age;
+    const double b = have_belief ? beliefDensity(beliefs[i], map, z, R, o.belief_sigma) : 0.0;
+    if (fix.valid && have_belief)
+      l[i] = (1.0 - o.belief_weight) * g + o.belief_weight * b;
+    else
+      l[i] = fix.valid ? g : b;
+    total += l[i];
+  }
+  const double norm = o.clutter_density + total;
+  r.clutter_probability = o.clutter_density / norm;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < pickers.size(); ++i) {
+    r.probabilities[i] = l[i] / norm;
+    if (r.probabilities[i] > r.probabilities[best]) best = i;
+  }
+  if (pickers.empty() || r.probabilities[best] < o.min_probability) return r;
+  r.picker = static_cast<int>(best);
+  r.observation.identifying = true;
+  r.observation.picker_id = pickers[best]->pickerId();
+  r.bias = pickers[best]->addSighting(person.stamp, z, R);
+  return r;
+}
+
+}  // namespace sensors
+}  // namespace picker_localisation
