@@ -1,5 +1,7 @@
 #include "picker_localisation/core/yaml_keys.h"
 
+#include <sstream>
+
 #include <algorithm>
 
 namespace picker_localisation {
@@ -47,6 +49,12 @@ std::vector<std::string> unknownKeys(const YAML::Node& node, const std::vector<s
                   (near.empty() ? "" : " (did you mean '" + near + "'?)"));
   }
   return out;
+}
+
+std::string badValue(const char* key, double value, const char* rule) {
+  std::ostringstream s;
+  s << key << " = " << value << ": must be " << rule;
+  return s.str();
 }
 
 }  // namespace core

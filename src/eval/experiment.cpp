@@ -648,7 +648,6 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
                   runs[k].samples);
       samples.push_back(std::move(runs[k].samples));
     }
-    if (specOf(method).lidar) writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
     MethodSummary row = summariseMethod(method, samples);
     res.rows.push_back(row);
     res.series.push_back(binErrors(method, samples, 0.0, std::max(5.0, config.duration / 100.0)));
@@ -659,6 +658,8 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
         << row.right_lane_share_std << ")"
         << std::setprecision(1) << "  [" << secs << " s wall]\n"
         << std::defaultfloat;
+    if (specOf(method).lidar)
+      writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
   }
   writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
   std::ostringstream title;

@@ -38,11 +38,7 @@ const std::vector<std::string>& GnssBiasOptions::yamlKeys() {
 }
 
 std::string GnssBiasOptions::validate() const {
-  auto bad = [](const char* key, double v, const char* rule) {
-    std::ostringstream s;
-    s << key << " = " << v << ": must be " << rule;
-    return s.str();
-  };
+  const auto bad = core::badValue;
   auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
   if (!(offset_std >= 0.0) || !std::isfinite(offset_std)) return bad("bias_offset_std", offset_std, "finite and >= 0");
   if (!(drift_std >= 0.0) || !std::isfinite(drift_std)) return bad("bias_drift_std", drift_std, "finite and >= 0");

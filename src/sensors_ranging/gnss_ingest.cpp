@@ -59,11 +59,7 @@ GnssIngestOptions GnssIngestOptions::fromYamlFile(const std::string& path,
 }
 
 std::string GnssIngestOptions::validate() const {
-  auto bad = [](const char* key, double v, const char* rule) {
-    std::ostringstream s;
-    s << key << " = " << v << ": must be " << rule;
-    return s.str();
-  };
+  const auto bad = core::badValue;
   if (!(default_sigma > 0.0) || !std::isfinite(default_sigma))
     return bad("default_sigma", default_sigma, "finite and > 0");
   if (!(min_sigma > 0.0) || !std::isfinite(min_sigma)) return bad("min_sigma", min_sigma, "finite and > 0");
@@ -103,11 +99,7 @@ const std::vector<std::string>& PickerAssociationOptions::yamlKeys() {
 }
 
 std::string PickerAssociationOptions::validate() const {
-  auto bad = [](const char* key, double v, const char* rule) {
-    std::ostringstream s;
-    s << key << " = " << v << ": must be " << rule;
-    return s.str();
-  };
+  const auto bad = core::badValue;
   if (!(clutter_density > 0.0) || !std::isfinite(clutter_density))
     return bad("association_clutter_density", clutter_density, "finite and > 0");
   if (!(min_probability > 0.5 && min_probability <= 1.0))

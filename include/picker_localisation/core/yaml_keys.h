@@ -18,6 +18,9 @@ std::string closestKey(const std::string& key, const std::vector<std::string>& k
 std::vector<std::string> unknownKeys(const YAML::Node& node, const std::vector<std::string>& known,
                                      const std::string& component);
 
+// The message of a validate() that refuses a value: "<key> = <value>: must be <rule>".
+std::string badValue(const char* key, double value, const char* rule);
+
 // Sets `value` from node[key] when present; a value of the wrong type throws std::runtime_error
 // "<component>: key '<key>' has the wrong type".
 template <typename T>
