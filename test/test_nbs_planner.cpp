@@ -73,6 +73,30 @@ TEST(NbsPlanner, RfidGainMatchesHandComputation) {
   }
 }
 
+// The same-lane LiDAR view (lidar/view_range): a stop 9 m up the picker's lane (outside the 3 m read disc)
+// gains nothing with RFID alone and gains with the view; a stop in the next lane gains nothing either way.
+TEST(NbsPlanner, LidarViewAlongTheLaneCountsInTheGain) {
+  auto map = wideTunnels();
+  const NodeIndex a = laneNode(*map, 0, 2), b = laneNode(*map, 0, 5), c = laneNode(*map, 0, 8);
+  StaticBeliefSource picker("p", uniformOver(*map, {a, b}));
+  PlannerConfig rfid_only;
+  const PlanResult r0 = NextBestSensePlanner(map, rfid_only).plan(c, 1.0, {&picker});
+  PlannerConfig with_view;
+  with_view.lidar.view_range = 10.0;
+  with_view.lidar.p_detect = 0.6;
+  const PlanResult r1 = NextBestSensePlanner(map, with_view).plan(c, 1.0, {&picker});
+  ASSERT_TRUE(r0.ok() && r1.ok());
+  EXPECT_DOUBLE_EQ(find(r0, c)->raw[kRfidGain], 0.0);
+  // From c, b (9 m) is in view, a (18 m) is not: seen -> certain, unseen -> (0.5, 0.5 (1 - p)) normalised.
+  const double p = 0.6;
+  const double q_a = 1 / (2 - p), q_b = (1 - p) / (2 - p);
+  const double expected = std::log(2.0) - (1 - 0.5 * p) * (-q_a * std::log(q_a) - q_b * std::log(q_b));
+  EXPECT_NEAR(find(r1, c)->raw[kRfidGain], expected, 1e-12);
+  EXPECT_DOUBLE_EQ(find(r1, laneNode(*map, 1, 5))->raw[kRfidGain], 0.0);  // beds hide the next lane
+  with_view.lidar.view_range = -1.0;
+  EXPECT_NE(with_view.validate(), "");
+}
+
 TEST(NbsPlanner, PrefersCandidateNearUncertainPicker) {
   auto map = wideTunnels();
   // Confident picker: all mass on one node of lane 0. Uncertain picker: spread over lane 4.

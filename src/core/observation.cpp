@@ -70,5 +70,12 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   return "";
 }
 
+bool concernsPicker(const Observation& obs, const std::string& picker_id) {
+  if (obs.identifying) return obs.picker_id == picker_id;
+  return obs.candidate_pickers.empty() ||
+         std::find(obs.candidate_pickers.begin(), obs.candidate_pickers.end(), picker_id) !=
+             obs.candidate_pickers.end();
+}
+
 }  // namespace core
 }  // namespace picker_localisation

@@ -367,7 +367,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   auto toTracker = [&](const core::Observation& obs) {
 #ifdef PL_HAVE_TPF
     for (auto& t : tracks) {
-      if (obs.identifying && obs.picker_id != t.id) continue;
+      if (!core::concernsPicker(obs, t.id)) continue;
       if (t.tpf) {
         t.tpf->update(obs);
         ++result.observations;
@@ -481,8 +481,18 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
           const sensors::AssociationResult a = sensors::associatePerson(
               sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id), ingests, beliefs, *map,
               gnss_options.association);
-          if (a.picker >= 0) ++result.identified_detections;
+          if (a.picker >= 0) {
+            ++result.identified_detections;
+            std::size_t nearest = 0;
+            double best = 1e300;
+            for (std::size_t j = 0; j < n; ++j) {
+              const double d = (simulator.pickerPose(j).position() - t.position).norm();
+              if (d < best) best = d, nearest = j;
+            }
+            if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) ++result.wrong_identifications;
+          }
           if (a.bias.accepted) ++result.bias_sightings;
+          if (a.concerns_nobody) continue;  // nobody we track (clutter under the association)
           if (spec.tracker == Tracker::kUkf) {
             if (a.picker >= 0)
               ukf.addGnss(s.stamp, a.observation.picker_id, t.position, a.observation.position_covariance);
@@ -658,8 +668,18 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
         << row.right_lane_share_std << ")"
         << std::setprecision(1) << "  [" << secs << " s wall]\n"
         << std::defaultfloat;
-    if (specOf(method).lidar)
+    if (specOf(method).lidar) {
+      std::size_t people = 0, identified = 0, wrong = 0, sightings = 0;
+      for (const RunResult& r : runs) {
+        people += r.lidar_detections;
+        identified += r.identified_detections;
+        wrong += r.wrong_identifications;
+        sightings += r.bias_sightings;
+      }
+      log << "    LiDAR people: " << people << ", identified " << identified << " (wrong picker " << wrong
+          << "), bias sightings accepted " << sightings << "\n";
       writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
+    }
   }
   writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
   std::ostringstream title;

@@ -145,6 +145,8 @@ std::string PlannerConfig::validate() const {
   if (!(rfid.p_detect > 0.0 && rfid.p_detect < 1.0)) return "rfid/p_detect must be in (0, 1)";
   if (!(rfid.min_sensing_time >= 0.0)) return "rfid/min_sensing_time must be >= 0";
   if (!positive(rfid.max_sensing_time)) return "rfid/max_sensing_time must be > 0";
+  if (!(lidar.view_range >= 0.0) || !std::isfinite(lidar.view_range)) return "lidar/view_range must be >= 0";
+  if (!(lidar.p_detect >= 0.0 && lidar.p_detect < 1.0)) return "lidar/p_detect must be in [0, 1)";
   if (!positive(energy.capacity)) return "energy/capacity must be > 0";
   if (!positive(energy.speed)) return "energy/speed must be > 0";
   if (!(energy.drive_energy_per_m >= 0.0 && energy.base_power >= 0.0 && energy.sensing_power >= 0.0))
@@ -192,6 +194,10 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node) {
     readKey(r, "p_detect", c.rfid.p_detect, "rfid/");
     readKey(r, "min_sensing_time", c.rfid.min_sensing_time, "rfid/");
     readKey(r, "max_sensing_time", c.rfid.max_sensing_time, "rfid/");
+  }
+  if (const YAML::Node l = node["lidar"]) {
+    readKey(l, "view_range", c.lidar.view_range, "lidar/");
+    readKey(l, "p_detect", c.lidar.p_detect, "lidar/");
   }
   if (const YAML::Node e = node["energy"]) {
     readKey(e, "capacity", c.energy.capacity, "energy/");
@@ -309,7 +315,19 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     const double travel_time = dist[c] / config_.energy.speed + config_.planning_latency;
     const long bucket = std::lround(travel_time / config_.horizon_bucket);
     const double horizon = static_cast<double>(bucket) * config_.horizon_bucket;
-    const std::vector<NodeIndex> region = map_->nodesWithin(map_->position2d(c), rfid.read_range);
+    // Sensing region: the RFID read disc and the LiDAR view along c's lane; p_miss(n) = P(not read, not seen).
+    std::vector<NodeIndex> region = map_->nodesWithin(map_->position2d(c), rfid.read_range);
+    std::map<NodeIndex, double> p_miss;
+    for (NodeIndex m : region) p_miss[m] = 1.0 - rfid.p_detect;
+    const topology::LaneIndex lane = map_->lane(c);
+    if (config_.lidar.view_range > 0.0 && config_.lidar.p_detect > 0.0 && lane != topology::kNoLane)
+      for (NodeIndex m : map_->nodesWithin(map_->position2d(c), config_.lidar.view_range))
+        if (map_->lane(m) == lane) {
+          auto it = p_miss.emplace(m, 1.0).first;
+          it->second *= 1.0 - config_.lidar.p_detect;
+        }
+    region.clear();
+    for (const auto& kv : p_miss) region.push_back(kv.first);
 
     double gain = 0.0, best_gain = 0.0, p_none_in_range = 1.0;
     std::string best_picker;
@@ -318,9 +336,13 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
       if (it == p.predicted.end()) it = p.predicted.emplace(bucket, p.source->predicted(horizon)).first;
       const NodeMasses& prior = it->second;
       if (prior.size() != n) continue;  // no belief for this picker yet
-      double in_region = 0.0;
-      for (NodeIndex m : region) in_region += prior[m];
+      double in_region = 0.0, p_read = 0.0;
+      for (NodeIndex m : region) {
+        in_region += prior[m];
+        p_read += prior[m] * (1.0 - p_miss[m]);
+      }
       in_region = std::clamp(in_region, 0.0, 1.0);
+      p_read = std::clamp(p_read, 0.0, 1.0);
       p_none_in_range *= 1.0 - in_region;
       if (in_region < kNegligibleMass || p.weight <= 0.0) continue;
       // Hypothetical RFID outcomes as rfid_ranging would report them (identifying, gamma_RFID = 1).
@@ -331,12 +353,13 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
       read.position = map_->position2d(c);
       core::Observation no_read = read;
       read.nodes = region;
-      read.likelihood.assign(region.size(), 1.0);
+      read.likelihood.clear();
+      // p(seen | n), scaled so that a node seen by RFID alone has 1 (RFID only: the paper's L(n) = 1).
+      for (NodeIndex m : region) read.likelihood.push_back((1.0 - p_miss[m]) / rfid.p_detect);
       no_read.nodes.resize(n);
       no_read.likelihood.assign(n, 1.0);
       for (std::size_t m = 0; m < n; ++m) no_read.nodes[m] = static_cast<NodeIndex>(m);
-      for (NodeIndex m : region) no_read.likelihood[m] = 1.0 - rfid.p_detect;
-      const double p_read = rfid.p_detect * in_region;
+      for (NodeIndex m : region) no_read.likelihood[m] = p_miss[m];
       const NodeMasses post_read = p.source->posterior(horizon, read);
       const NodeMasses post_none = p.source->posterior(horizon, no_read);
       result.what_if_queries += 2;

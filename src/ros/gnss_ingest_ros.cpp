@@ -190,6 +190,10 @@ void GnssIngestNode::processPerson(const core::Observation& person) {
       ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
                 a.bias.reason.c_str());
   }
+  if (a.concerns_nobody) {
+    ++nobody_;
+    return;
+  }
   pub_.publish(toMsg(a.observation, *map_, frame_id_));
   ++published_;
 }
@@ -277,8 +281,9 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     rejected += c.received - c.accepted;
   }
   stat.add("published", published_);
-  stat.add("people received / identified / dropped", std::to_string(people_) + " / " + std::to_string(identified_) +
-                                                         " / " + std::to_string(bad_people_));
+  stat.add("people received / identified / nobody's / malformed",
+           std::to_string(people_) + " / " + std::to_string(identified_) + " / " + std::to_string(nobody_) + " / " +
+               std::to_string(bad_people_));
   stat.add("waiting for stamp order", ordering_.size());
   for (const sensors::GnssIngest& g : ingest_) {
     const sensors::GnssBiasEstimator& b = g.bias();

@@ -15,6 +15,7 @@ picker_localisation::Observation toMsg(const core::Observation& obs, const topol
   msg.robot_id = obs.robot_id;
   msg.picker_id = obs.picker_id;
   msg.identifying = obs.identifying;
+  msg.candidate_pickers = obs.candidate_pickers;
   msg.nodes.reserve(obs.nodes.size());
   for (topology::NodeIndex n : obs.nodes) msg.nodes.push_back(map.node(n).name);
   msg.likelihood = obs.likelihood;
@@ -40,6 +41,7 @@ core::Observation fromMsg(const picker_localisation::Observation& msg, const top
   obs.robot_id = msg.robot_id;
   obs.picker_id = msg.picker_id;
   obs.identifying = msg.identifying;
+  obs.candidate_pickers = msg.candidate_pickers;
   std::size_t unknown = 0;
   const std::size_t n = std::min(msg.nodes.size(), msg.likelihood.size());
   for (std::size_t i = 0; i < n; ++i) {

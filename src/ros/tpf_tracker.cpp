@@ -218,8 +218,12 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_
 
 void TpfTracker::observationCallback(const picker_localisation::Observation::ConstPtr& msg) {
   ++received_;
-  if (msg->identifying && msg->picker_id != picker_id_) {
-    ++other_picker_;  // another picker's identifying observation: not ours
+  const bool ours = msg->identifying ? msg->picker_id == picker_id_
+                                     : msg->candidate_pickers.empty() ||
+                                           std::find(msg->candidate_pickers.begin(), msg->candidate_pickers.end(),
+                                                     picker_id_) != msg->candidate_pickers.end();
+  if (!ours) {
+    ++other_picker_;  // another picker's (identifying, or an anonymous one this picker cannot be)
     return;
   }
   checkClockJump();
@@ -370,7 +374,7 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("dropped (too old)", c.dropped_too_old);
   stat.add("rejected (invalid)", c.rejected_invalid);
   stat.add("ignored (sensor not fused in this mode)", c.ignored_sensor);
-  stat.add("ignored (another picker's identifying)", other_picker_);
+  stat.add("ignored (another picker's)", other_picker_);
   stat.add("unknown node names skipped", unknown_nodes_);
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);

@@ -25,6 +25,7 @@ GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
   core::readOption(y, c, "bias_pairing_speed", o.pairing_speed);
   core::readOption(y, c, "bias_gate_sigmas", o.gate_sigmas);
   core::readOption(y, c, "bias_max_age", o.max_age);
+  core::readOption(y, c, "bias_error_inflation", o.error_inflation);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
   return o;
@@ -33,7 +34,8 @@ GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
 const std::vector<std::string>& GnssBiasOptions::yamlKeys() {
   static const std::vector<std::string> keys = {
       "estimate_bias",     "bias_offset_std",  "bias_drift_std",     "bias_drift_tau",   "bias_residual_std",
-      "bias_min_sigma",    "bias_pairing_gap", "bias_pairing_speed", "bias_gate_sigmas", "bias_max_age"};
+      "bias_min_sigma",    "bias_pairing_gap", "bias_pairing_speed", "bias_gate_sigmas", "bias_max_age",
+      "bias_error_inflation"};
   return keys;
 }
 
@@ -51,6 +53,8 @@ std::string GnssBiasOptions::validate() const {
     return bad("bias_pairing_speed", pairing_speed, "finite and >= 0");
   if (!positive(gate_sigmas)) return bad("bias_gate_sigmas", gate_sigmas, "finite and > 0");
   if (!(max_age > 0.0)) return bad("bias_max_age", max_age, "> 0");
+  if (!(error_inflation >= 1.0) || !std::isfinite(error_inflation))
+    return bad("bias_error_inflation", error_inflation, "finite and >= 1");
   return "";
 }
 

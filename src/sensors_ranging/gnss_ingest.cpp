@@ -85,6 +85,7 @@ PickerAssociationOptions PickerAssociationOptions::fromYaml(const YAML::Node& y)
   core::readOption(y, c, "association_speed", o.speed);
   core::readOption(y, c, "association_max_belief_age", o.max_belief_age);
   core::readOption(y, c, "association_belief_lag", o.belief_lag);
+  core::readOption(y, c, "association_min_candidate_probability", o.min_candidate_probability);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
   return o;
@@ -94,7 +95,8 @@ const std::vector<std::string>& PickerAssociationOptions::yamlKeys() {
   static const std::vector<std::string> keys = {
       "associate_people",         "association_clutter_density", "association_min_probability",
       "association_belief_weight", "association_belief_sigma",   "association_max_fix_age",
-      "association_speed",        "association_max_belief_age",  "association_belief_lag"};
+      "association_speed",        "association_max_belief_age",  "association_belief_lag",
+      "association_min_candidate_probability"};
   return keys;
 }
 
@@ -104,6 +106,8 @@ std::string PickerAssociationOptions::validate() const {
     return bad("association_clutter_density", clutter_density, "finite and > 0");
   if (!(min_probability > 0.5 && min_probability <= 1.0))
     return bad("association_min_probability", min_probability, "in (0.5, 1]");
+  if (!(min_candidate_probability >= 0.0 && min_candidate_probability < min_probability))
+    return bad("association_min_candidate_probability", min_candidate_probability, "in [0, association_min_probability)");
   if (!(belief_weight >= 0.0 && belief_weight <= 1.0))
     return bad("association_belief_weight", belief_weight, "in [0, 1]");
   if (!(belief_sigma > 0.0) || !std::isfinite(belief_sigma))
@@ -256,7 +260,8 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
     lo.min_sigma = options_.bias.min_sigma;
     const Eigen::Vector2d corrected = p - bias_.bias(fix.stamp);
     obs.position = corrected;
-    obs.position_covariance = bias_.covariance(fix.stamp) + r2 * Eigen::Matrix2d::Identity();
+    obs.position_covariance =
+        options_.bias.error_inflation * bias_.covariance(fix.stamp) + r2 * Eigen::Matrix2d::Identity();
     result.bias_corrected = true;
   } else {
     obs.position = p;

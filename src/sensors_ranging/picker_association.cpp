@@ -85,7 +85,15 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
     r.probabilities[i] = l[i] / norm;
     if (r.probabilities[i] > r.probabilities[best]) best = i;
   }
-  if (pickers.empty() || r.probabilities[best] < o.min_probability) return r;
+  if (pickers.empty() || r.probabilities[best] < o.min_probability) {
+    if (o.min_candidate_probability > 0.0 && !pickers.empty()) {
+      for (std::size_t i = 0; i < pickers.size(); ++i)
+        if (r.probabilities[i] >= o.min_candidate_probability)
+          r.observation.candidate_pickers.push_back(pickers[i]->pickerId());
+      r.concerns_nobody = r.observation.candidate_pickers.empty();
+    }
+    return r;
+  }
   r.picker = static_cast<int>(best);
   r.observation.identifying = true;
   r.observation.picker_id = pickers[best]->pickerId();

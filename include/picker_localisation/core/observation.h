@@ -20,6 +20,9 @@ struct Observation {
   std::string robot_id;          // robot whose sensor produced it; empty for picker-worn devices
   std::string picker_id;         // identified picker; empty when !identifying
   bool identifying = false;
+  // Not identifying: the pickers it may concern, e.g. those an anonymous person could be (association
+  // probability above a floor); empty = every picker (paper Sec. VI: anonymous observations reach every filter).
+  std::vector<std::string> candidate_pickers;
   std::vector<topology::NodeIndex> nodes;  // support of the likelihood (unique indices)
   std::vector<double> likelihood;          // >= 0, one per entry of nodes; need not sum to 1
   std::optional<Eigen::Vector2d> velocity;  // m/s, map frame
@@ -29,6 +32,10 @@ struct Observation {
   bool empty() const { return nodes.empty(); }
   double totalLikelihood() const;
 };
+
+// True when the observation is for `picker_id`'s filter: its identified picker, or (not identifying) one of its
+// candidate pickers, or every picker when it names none.
+bool concernsPicker(const Observation& obs, const std::string& picker_id);
 
 // Options of a Gaussian node likelihood.
 struct GaussianLikelihoodOptions {

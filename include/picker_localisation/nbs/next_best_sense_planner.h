@@ -10,7 +10,8 @@
 //                               the window with probability p_detect); with q(c) = P(at least one picker
 //                               within read_range of c) under the predicted beliefs, ST = min_sensing_time +
 //                               q (1 - e^{-r T}) / r + (1 - q) T,  T = max_sensing_time.
-//  rfid_gain [nats], benefit:   expected entropy reduction of the pickers' beliefs by the sensing operation:
+//  rfid_gain [nats], benefit:   expected entropy reduction of the pickers' beliefs by the sensing operation
+//                               (RFID reads and, with lidar/view_range > 0, the same-lane LiDAR view):
 //                               sum_k w_k [H(b_k) - P_k(read) H(b_k | read) - P_k(no read) H(b_k | no read)],
 //                               b_k the belief of picker k predicted to the arrival time (travel time
 //                               = travel_distance / speed), the posteriors from the BeliefSource what-if with
@@ -65,6 +66,17 @@ struct RfidSensingModel {
   double expectedSensingTime(double q) const;
 };
 
+// The LiDAR view the planner expects at a candidate (issue "Find the lane"): a stop in a lane sees the people in
+// that lane within view_range (the beds hide the neighbouring lanes at leg height), and a person seen there is
+// associated with its picker and corrects its GNSS bias, which names the lane. Folded into the sensing
+// outcome of the rfid_gain criterion: "seen" means read or seen, p(seen | n) = 1 - (1 - p_rfid [n in read
+// disc]) (1 - p_detect [n in the view]). view_range 0 = RFID only (the paper's criterion).
+struct LidarSensingModel {
+  double view_range = 0.0;  // m along the candidate's lane (e.g. 8: leg_detector max_leg_range); 0 = off, as
+                            // measured best (docs/readme/nbs.md)
+  double p_detect = 0.6;    // probability that a picker in view is seen and identified during the stop
+};
+
 // Energy of driving and sensing (a Thorvald-size robot on a 48 V pack; see docs/readme/nbs.md):
 //   E = drive_energy_per_m * d + base_power * (d / speed + t_sense) + sensing_power * t_sense   [J]
 //   battery after = level - E / capacity.
@@ -92,6 +104,7 @@ struct PlannerConfig {
   double horizon_bucket = 2.0;    // s, arrival times are rounded to this step to share predictions
   double planning_latency = 0.0;  // s added to every arrival time (belief age at planning)
   RfidSensingModel rfid;
+  LidarSensingModel lidar;
   EnergyModel energy;
   double claimed_picker_weight = 0.0;  // w_k of a picker served by a higher-priority robot
   int claim_exclusion_hops = 0;        // nodes within this many hops of a claimed goal are excluded too

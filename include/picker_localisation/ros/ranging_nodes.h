@@ -91,7 +91,7 @@ class GnssIngestNode {
   ros::Timer ordering_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t published_ = 0, people_ = 0, identified_ = 0, bad_people_ = 0;
+  std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0;
   StampGuard stamp_guard_;
 };
 

@@ -40,6 +40,10 @@ struct GnssBiasOptions {
   double pairing_speed = 1.0;  // m/s, picker motion between fix and sighting: adds (speed * gap)^2 to R
   double gate_sigmas = 3.5;    // a sighting whose innovation exceeds this Mahalanobis distance is refused
   double max_age = 600.0;      // s after the last sighting beyond which corrections stop (estimate = prior)
+  // Every corrected fix carries the same estimate error, but the filter fuses fixes as independent: N fixes
+  // would count that error N times too few. The estimate's covariance in a corrected fix's likelihood is
+  // multiplied by this factor (1: as if independent).
+  double error_inflation = 1.0;
 
   // Keys bias_<name> (enabled: estimate_bias) of config/gnss_ingest.yaml; a bad value throws
   // std::runtime_error naming the key. Unknown keys are checked by GnssIngestOptions.

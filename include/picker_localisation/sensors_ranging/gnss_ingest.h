@@ -50,6 +50,8 @@ struct PickerAssociationOptions {
   double clutter_density = 5e-4;     // 1/m^2, density of people detections that are no listed picker (false
                                      // legs, other workers): the "nobody we track" hypothesis
   double min_probability = 0.8;      // association probability at which a detection identifies its picker
+  double min_candidate_probability = 0.05;  // an unidentified detection reaches the trackers of the pickers
+                                     // with at least this probability (0: every tracker, as the paper)
   double belief_weight = 0.5;        // share of the tracker's belief in the picker's predicted position
                                      // (the rest: the bias-corrected fix); 0 = fix only
   double belief_sigma = 1.0;         // m, spread of a belief node's mass around the node (half a node spacing

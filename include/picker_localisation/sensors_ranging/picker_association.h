@@ -10,7 +10,8 @@
 // hypothesis "nobody we track" (clutter density c: false legs, other workers) the association probabilities
 // are p_i = l_i / (c + sum_j l_j) (one detection, one picker at most: the standard single-scan PDA form).
 // p_i >= min_probability makes the detection an identifying observation of picker i and a metric sighting for
-// its bias estimate; anything less stays anonymous and reaches every tracker as before. Before the first
+// its bias estimate; anything less stays anonymous, for the trackers of the pickers whose p_i reaches
+// association_min_candidate_probability (Observation::candidate_pickers; none: not published at all). Before the first
 // sighting the bias prior is wide (sqrt(offset_std^2 + drift_std^2) = 3.2 m per axis), so only a detection that
 // is both near the fix and far from every other picker is identified; once identified, the corrected fix is
 // sharp and the next sightings follow.
@@ -67,6 +68,8 @@ struct AssociationResult {
   int picker = -1;                    // index of the identified picker, -1 when anonymous
   std::vector<double> probabilities;  // p_i per picker
   double clutter_probability = 1.0;   // c / (c + sum_j l_j)
+  bool concerns_nobody = false;       // anonymous and no picker reaches min_candidate_probability: not
+                                      // published (it is nobody we track)
   BiasUpdate bias;                    // the identified picker's bias update (accepted or why not)
 };
 
