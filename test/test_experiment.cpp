@@ -207,4 +207,41 @@ TEST(Experiment, RawFixIsTheNodeNearestTheLatestFix) {
   for (const auto& s : r.samples) close += s.euclidean < 2.0 ? 1 : 0;
   EXPECT_GT(static_cast<double>(close) / r.samples.size(), 0.9);
 }
+// Issue "Find the lane": with Table I GNSS (2-5 m bias) the robot's LiDAR people are given to the picker, its
+// bias estimate follows the simulator's true GNSS error, and a fresh estimate names the lane. Ground truth is
+// used here for scoring only.
+TEST(Experiment, LidarPeopleTeachTheGnssBias) {
+  auto map = std::make_shared<const topology::TopologicalMap>(
+      topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
+  RunConfig rc;
+  rc.scenario = Scenario::kSingle;
+  rc.method = "lidar_gnss";
+  rc.seed = 1;
+  rc.duration = 300.0;
+  const RunResult r = runOnce(map, rc);
+  ASSERT_GT(r.lidar_detections, 50u);
+  EXPECT_GT(r.identified_detections, r.lidar_detections * 9 / 10);
+  EXPECT_EQ(r.wrong_identifications, 0u);
+  EXPECT_GT(r.bias_sightings, r.identified_detections / 2);
+  std::size_t fresh = 0, fresh_right = 0, fresh_lane = 0;
+  double fresh_residual = 0.0, never_residual = 0.0;
+  std::size_t never = 0;
+  for (const BiasSample& b : r.bias_samples) {
+    if (b.sighting_age < 10.0) {
+      ++fresh;
+      fresh_residual += b.residual;
+      if (b.lane_applicable) {
+        ++fresh_lane;
+        fresh_right += b.in_true_lane;
+      }
+    } else if (!std::isfinite(b.sighting_age)) {
+      ++never;
+      never_residual += b.residual;
+    }
+  }
+  ASSERT_GT(fresh_lane, 20u);
+  EXPECT_LT(fresh_residual / fresh, 1.0);  // m: the estimate is within a metre of the true error
+  if (never > 0) EXPECT_GT(never_residual / never, fresh_residual / fresh);
+  EXPECT_GT(static_cast<double>(fresh_right) / fresh_lane, 0.85);
+}
 #endif

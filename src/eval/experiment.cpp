@@ -263,6 +263,9 @@ struct PickerTrack {
   NodeIndex raw_fix_node = topology::kInvalidNode;  // raw_fix: the node nearest the latest accepted fix
   Eigen::Vector2d true_gnss_error{std::nan(""), std::nan("")};  // scoring only: the simulator's error of the
                                                                // latest fix (never reaches an estimator)
+  // Scoring the "lane right within 30 s of a sighting after the first fix or a blackout" criterion.
+  double restart = std::nan("");             // stamp of the first fix, or of the fix that ended a blackout
+  double seen_after_restart = std::nan("");  // first accepted bias sighting after it
 };
 
 }  // namespace
@@ -425,6 +428,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         if (f.error.allFinite()) t.true_gnss_error = f.error;
         const sensors::GnssResult r = t.gnss->process(toIngestFix(f));
         if (!r.accepted()) continue;
+        if (t.gnss->counters().accepted == 1 || r.blackout_ended > 0.0) {
+          t.restart = f.stamp;
+          t.seen_after_restart = std::nan("");
+        }
         if (spec.tracker == Tracker::kRawFix) {
           t.raw_fix_node = map->nearestNode(r.position);
         } else if (spec.tracker == Tracker::kUkf && r.bias_corrected) {
@@ -491,7 +498,11 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
             }
             if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) ++result.wrong_identifications;
           }
-          if (a.bias.accepted) ++result.bias_sightings;
+          if (a.bias.accepted) {
+            ++result.bias_sightings;
+            PickerTrack& seen = tracks[static_cast<std::size_t>(a.picker)];
+            if (!std::isnan(seen.restart) && std::isnan(seen.seen_after_restart)) seen.seen_after_restart = s.stamp;
+          }
           if (a.concerns_nobody) continue;  // nobody we track (clutter under the association)
           if (spec.tracker == Tracker::kUkf) {
             if (a.picker >= 0)
@@ -547,6 +558,16 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
           bs.lane_applicable = result.samples.back().lane_applicable;
           bs.in_true_lane = result.samples.back().in_true_lane;
           result.bias_samples.push_back(bs);
+        }
+        PickerTrack& t = tracks[i];
+        if (!std::isnan(t.seen_after_restart)) {
+          const ErrorSample& e = result.samples.back();
+          const double since = next_sample - t.seen_after_restart;
+          if ((e.lane_applicable && e.in_true_lane) || since > 120.0) {
+            result.lane_delays.push_back(e.lane_applicable && e.in_true_lane ? since
+                                                                             : std::numeric_limits<double>::infinity());
+            t.restart = t.seen_after_restart = std::nan("");
+          }
         }
       }
       next_sample += config.sample_period;
@@ -678,6 +699,15 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
       }
       log << "    LiDAR people: " << people << ", identified " << identified << " (wrong picker " << wrong
           << "), bias sightings accepted " << sightings << "\n";
+      std::vector<double> delays;
+      for (const RunResult& r : runs) delays.insert(delays.end(), r.lane_delays.begin(), r.lane_delays.end());
+      if (!delays.empty()) {
+        std::sort(delays.begin(), delays.end());
+        const auto within = std::count_if(delays.begin(), delays.end(), [](double d) { return d <= 30.0; });
+        log << "    first sighting after a first fix or a blackout: " << delays.size() << ", lane right within 30 s in "
+            << std::setprecision(2) << std::fixed << static_cast<double>(within) / delays.size() << ", median "
+            << std::setprecision(1) << delays[delays.size() / 2] << " s" << std::defaultfloat << "\n";
+      }
       writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
     }
   }

@@ -86,6 +86,9 @@ struct RunResult {
   std::size_t lidar_detections = 0;
   std::size_t identified_detections = 0;  // LiDAR people that the association gave to one picker
   std::size_t bias_sightings = 0;         // of those, accepted by the picker's GNSS bias estimate
+  // Scoring: s from the first bias sighting after a picker's first fix or a GNSS blackout until its estimate
+  // is first in the right lane (+inf: not within 120 s).
+  std::vector<double> lane_delays;
   std::size_t wrong_identifications = 0;  // scoring only: identified as a picker other than the one nearest
                                           // the detection (within 1 m) in the simulator's truth
   double wall_seconds = 0.0;
