@@ -5,7 +5,10 @@
 # 3. the offline runner scores `raw_fix` (node nearest the latest accepted fix), `khan_connected` and `gnss_tpf` on
 #    the same seed and map (same pickers and fixes: the simulator is shared, see docs/readme/eval.md).
 # Prints one JSON object. Usage: scripts/bench_gnss_replay.sh MAP [DURATION=900] [SEED=1] [WORK_DIR]
-# Environment: BUILD_DIR (default build), RATE (farm_sim rate factor, 10), REPLAY_RATE (5).
+# Environment: BUILD_DIR (default build), RATE (farm_sim rate factor, 10), REPLAY_RATE (5),
+#   SENSORS: gnss (default, as above) | lidar_rfid: the patrolling robot's lasers and RFID reader are simulated and
+#   recorded too, the replay runs leg_detector and rfid_ranging, gnss_ingest associates the people and learns the
+#   GNSS biases (issue "Find the lane"), and the runner scores khan_connected and rfid_lidar_gnss.
 set -eo pipefail
 cd "$(dirname "$0")/.."
 MAP="$(realpath "${1:?usage: bench_gnss_replay.sh MAP [DURATION] [SEED] [WORK_DIR]}")"
@@ -20,8 +23,17 @@ mkdir -p "$ROS_HOME"
 # shellcheck disable=SC1091
 source "$BUILD_DIR/devel/setup.bash"
 # GNSS only: every other simulated sensor off (the pickers' walks and GNSS errors do not depend on them).
-sed -e 's/^  laser: true/  laser: false/' -e 's/^  rfid: true/  rfid: false/' -e 's/^  uwb: true/  uwb: false/' \
-    -e 's/^  camera: true/  camera: false/' config/sim.yaml > "$WORK/sim_gnss_only.yaml"
+SENSORS="${SENSORS:-gnss}"
+REGEX="/tf|/tf_static|/pickers/[^/]+/(fix|ground_truth)"
+METHODS=raw_fix,khan_connected,gnss_tpf
+if [ "$SENSORS" = lidar_rfid ]; then
+  sed -e 's/^  uwb: true/  uwb: false/' -e 's/^  camera: true/  camera: false/' config/sim.yaml > "$WORK/sim_gnss_only.yaml"
+  REGEX="$REGEX|/robot_[0-9]+/(scan_front|scan_rear|rfid|ground_truth)"
+  METHODS=khan_connected,rfid_lidar_gnss
+else
+  sed -e 's/^  laser: true/  laser: false/' -e 's/^  rfid: true/  rfid: false/' -e 's/^  uwb: true/  uwb: false/' \
+      -e 's/^  camera: true/  camera: false/' config/sim.yaml > "$WORK/sim_gnss_only.yaml"
+fi
 own_master() {  # log args...
   local log="$WORK/$1.log"; shift
   local port=$((20000 + RANDOM % 20000))
@@ -39,7 +51,7 @@ cat > "$WORK/record.launch" <<EOF
   </include>
   <include file="\$(find picker_localisation)/launch/record.launch">
     <arg name="bag" value="$WORK/gnss.bag"/>
-    <arg name="regex" value="/tf|/tf_static|/pickers/[^/]+/(fix|ground_truth)"/>
+    <arg name="regex" value="$REGEX"/>
   </include>
 </launch>
 EOF
@@ -50,10 +62,10 @@ own_master replay picker_localisation replay.launch bag:="$WORK/gnss.bag" rate:=
   map_file:="$MAP" output_csv:="$WORK/graph_errors.csv"
 [ -s "$WORK/graph_errors.csv" ] || { echo "replay wrote no errors: $WORK/replay.log" >&2; exit 1; }
 "$BUILD_DIR/devel/lib/picker_localisation/experiment" --map "$MAP" --scenario multi --runs 1 --seed "$SEED" \
-  --duration "$DURATION" --methods raw_fix,khan_connected,gnss_tpf --out "$WORK/runner" > "$WORK/runner.log"
-python3 - "$WORK/graph_errors.csv" "$WORK/runner/summary.csv" "$MAP" "$DURATION" "$SEED" <<'EOF'
+  --duration "$DURATION" --methods "$METHODS" --out "$WORK/runner" > "$WORK/runner.log"
+python3 - "$WORK/graph_errors.csv" "$WORK/runner/summary.csv" "$MAP" "$DURATION" "$SEED" "$SENSORS" <<'EOF'
 import csv, json, math, sys
-graph, summary, map_file, duration, seed = sys.argv[1:]
+graph, summary, map_file, duration, seed = sys.argv[1:6]
 rows = list(csv.DictReader(open(graph)))
 def col(*names):
     for n in names:
@@ -63,7 +75,7 @@ def col(*names):
 topo, lane_ok, lane_app = col("topological_error", "topological"), col("in_true_lane"), col("lane_applicable")
 t = [float(r[topo]) for r in rows if float(r[topo]) >= 0]
 lane = [int(r[lane_ok]) for r in rows if int(r[lane_app])]
-out = {"map": map_file, "duration_s": float(duration), "seed": int(seed),
+out = {"map": map_file, "duration_s": float(duration), "seed": int(seed), "sensors": sys.argv[6],
        "graph_tpf": {"samples": len(rows), "topological_mean": sum(t) / len(t),
                      "right_lane_share": sum(lane) / len(lane) if lane else math.nan}}
 for r in csv.DictReader(open(summary)):

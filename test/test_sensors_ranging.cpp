@@ -1062,3 +1062,32 @@ TEST(PickerAssociation, NeighboursInAdjacentLanesDoNotSwapIdentities) {
     EXPECT_LT((f.ingest[i].bias().bias(60.1) - bias[i]).norm(), 0.5) << "picker " << i;
   }
 }
+
+TEST(PickerAssociation, IdentifyingSightingsOnlyFromTheListedSensors) {
+  ThreeLanes f;
+  f.fixes(1.0, {{-15.0, 0.0}, {0.0, 1.5}, {15.0, 3.0}});
+  core::Observation uwb = f.person(1.2, {1.0, 1.0});
+  uwb.sensor = "uwb";
+  uwb.identifying = true;
+  uwb.picker_id = "picker_2";
+  // Default bias_sighting_sensors is empty (rfid measured harmful, see gnss_bias.h): not a sighting.
+  EXPECT_FALSE(addIdentifyingSighting(uwb, f.pickers));
+  EXPECT_FALSE(f.ingest[1].bias().sighted());
+  GnssIngestOptions o;
+  o.bias.sighting_sensors = {"uwb"};
+  GnssIngest listed("picker_2", f.fx.map, f.fx.datum, o);
+  ASSERT_TRUE(listed.process(f.fx.fixAt(1.0, {0.0, 1.5}, 9.0)).accepted());
+  std::vector<GnssIngest*> one = {&listed};
+  EXPECT_TRUE(addIdentifyingSighting(uwb, one));
+  EXPECT_TRUE(listed.bias().sighted());
+  core::Observation other = uwb;
+  other.sensor = "rfid";  // not listed
+  EXPECT_FALSE(addIdentifyingSighting(other, one));
+  other = uwb;
+  other.identifying = false;
+  EXPECT_FALSE(addIdentifyingSighting(other, one));
+  other = uwb;
+  other.picker_id = "picker_9";
+  EXPECT_FALSE(addIdentifyingSighting(other, one));
+  EXPECT_EQ(listed.bias().sightings(), 1u);
+}

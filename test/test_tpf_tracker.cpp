@@ -155,6 +155,18 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
            topics_["picker_1"].beliefs.back().observations == b1.observations + 1;
   }));
 
+  // 3b. An unidentified detection that names its candidate pickers (gnss_ingest's association) reaches only
+  // those: picker_3 fuses it, picker_1 does not.
+  {
+    core::Observation only3 = observationAt(node_a, "lidar", "");
+    only3.candidate_pickers = {"picker_3"};
+    const std::uint32_t p1 = topics_["picker_1"].beliefs.back().observations;
+    send(only3);
+    ASSERT_TRUE(waitFor([&] { return topics_["picker_3"].beliefs.back().observations == 2; }));
+    spinFor(0.3);
+    EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, p1) << "picker_1 fused picker_3's candidate";
+  }
+
   // 4. Periodic prediction (picker_1 at 2 Hz) without observations: newer stamps, same observation count.
   const double last_stamp = topics_["picker_1"].beliefs.back().header.stamp.toSec();
   ASSERT_TRUE(waitFor(

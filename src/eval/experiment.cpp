@@ -460,7 +460,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         const sim::Pose2D antenna = simulator.robotPose(rr.robot_index).compose(mount);
         read.antenna_pose = Eigen::Vector3d(antenna.x, antenna.y, antenna.yaw);
         const sensors::RfidResult r = rfid_model.process(read);
-        if (r.observation) toTracker(*r.observation);
+        if (r.observation) {
+          if (sensors::addIdentifyingSighting(*r.observation, ingests)) ++result.bias_sightings;
+          toTracker(*r.observation);
+        }
         for (const auto& neg : r.negative) toTracker(neg);
       } else {
 #ifdef PL_HAVE_VISION

@@ -1,5 +1,6 @@
 #include <visualization_msgs/MarkerArray.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -69,6 +70,9 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
         person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
     ROS_INFO("gnss_ingest: associating anonymous people from %s with the pickers", person_topic.c_str());
   }
+  if (!o.bias.sighting_sensors.empty())
+    subs_.push_back(nh.subscribe<picker_localisation::Observation>(
+        topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onIdentified(m); }));
   if (ordering_latency_ > 0.0)
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
                                      [this](const ros::TimerEvent&) { releaseOrdered(); });
@@ -77,6 +81,12 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
   ok_ = true;
+}
+
+std::vector<sensors::GnssIngest*> GnssIngestNode::pickerPointers() {
+  std::vector<sensors::GnssIngest*> pickers;
+  for (auto& g : ingest_) pickers.push_back(&g);
+  return pickers;
 }
 
 bool GnssIngestNode::checkClock() {
@@ -140,6 +150,23 @@ void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& 
   ordering_.push(in.person.stamp, key.str(), std::move(in));
 }
 
+void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
+  const auto& sensors = options_.bias.sighting_sensors;
+  if (!msg->identifying || std::find(sensors.begin(), sensors.end(), msg->sensor) == sensors.end()) return;
+  checkClock();
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;
+  Input in;
+  in.is_fix = false;
+  in.is_sighting = true;
+  in.person = fromMsg(*msg, *map_);
+  if (!in.person.position) return;
+  if (ordering_latency_ <= 0.0) {
+    sensors::addIdentifyingSighting(in.person, pickerPointers());
+    return;
+  }
+  ordering_.push(in.person.stamp, "sighting|" + msg->sensor + "|" + msg->picker_id + "|" + msg->robot_id, std::move(in));
+}
+
 void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t i) {
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
@@ -155,10 +182,13 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr&
 void GnssIngestNode::releaseOrdered() {
   if (checkClock()) return;
   for (auto& item : ordering_.release(ros::Time::now().toSec())) {
-    if (item.second.is_fix)
+    if (item.second.is_fix) {
       processFix(item.second.picker, item.second.fix);
-    else
+    } else if (item.second.is_sighting) {
+      sensors::addIdentifyingSighting(item.second.person, pickerPointers());
+    } else {
       processPerson(item.second.person);
+    }
   }
 }
 
@@ -179,10 +209,8 @@ void GnssIngestNode::processFix(std::size_t i, const sensors::GnssFix& fix) {
 
 void GnssIngestNode::processPerson(const core::Observation& person) {
   ++people_;
-  std::vector<sensors::GnssIngest*> pickers;
-  for (auto& g : ingest_) pickers.push_back(&g);
   const sensors::AssociationResult a = sensors::associatePerson(
-      person, pickers, sensors::beliefViews(beliefs_, person.stamp, options_.association), *map_,
+      person, pickerPointers(), sensors::beliefViews(beliefs_, person.stamp, options_.association), *map_,
       options_.association);
   if (a.picker >= 0) {
     ++identified_;

@@ -26,6 +26,7 @@ GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
   core::readOption(y, c, "bias_gate_sigmas", o.gate_sigmas);
   core::readOption(y, c, "bias_max_age", o.max_age);
   core::readOption(y, c, "bias_error_inflation", o.error_inflation);
+  core::readOption(y, c, "bias_sighting_sensors", o.sighting_sensors);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
   return o;
@@ -35,7 +36,7 @@ const std::vector<std::string>& GnssBiasOptions::yamlKeys() {
   static const std::vector<std::string> keys = {
       "estimate_bias",     "bias_offset_std",  "bias_drift_std",     "bias_drift_tau",   "bias_residual_std",
       "bias_min_sigma",    "bias_pairing_gap", "bias_pairing_speed", "bias_gate_sigmas", "bias_max_age",
-      "bias_error_inflation"};
+      "bias_error_inflation", "bias_sighting_sensors"};
   return keys;
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 
 namespace picker_localisation {
@@ -99,6 +100,18 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
   r.observation.picker_id = pickers[best]->pickerId();
   r.bias = pickers[best]->addSighting(person.stamp, z, R);
   return r;
+}
+
+bool addIdentifyingSighting(const core::Observation& obs, const std::vector<GnssIngest*>& pickers) {
+  if (!obs.identifying || !obs.position || !obs.position->allFinite() || !obs.position_covariance.allFinite())
+    return false;
+  for (GnssIngest* g : pickers) {
+    if (g->pickerId() != obs.picker_id) continue;
+    const auto& sensors = g->options().bias.sighting_sensors;
+    if (std::find(sensors.begin(), sensors.end(), obs.sensor) == sensors.end()) return false;
+    return g->addSighting(obs.stamp, *obs.position, obs.position_covariance).accepted;
+  }
+  return false;
 }
 
 }  // namespace sensors

@@ -63,6 +63,7 @@ class GnssIngestNode {
  private:
   struct Input {
     bool is_fix = true;
+    bool is_sighting = false;  // an identifying RFID / UWB observation (bias_sighting_sensors)
     std::size_t picker = 0;
     sensors::GnssFix fix;
     core::Observation person;
@@ -70,7 +71,9 @@ class GnssIngestNode {
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
   void onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t picker);
+  void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
   bool checkClock();
+  std::vector<sensors::GnssIngest*> pickerPointers();
   void releaseOrdered();
   void processFix(std::size_t picker, const sensors::GnssFix& fix);
   void processPerson(const core::Observation& person);

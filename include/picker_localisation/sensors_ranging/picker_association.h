@@ -81,5 +81,10 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
                                   const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
                                   const PickerAssociationOptions& options);
 
+// An identifying observation of a sensor in bias_sighting_sensors (RFID, UWB) with a metric position is a
+// sighting of its picker: GnssIngest::addSighting with the observation's position and covariance. Returns
+// whether it was used (false: not such an observation, unknown picker, or refused by the estimate).
+bool addIdentifyingSighting(const core::Observation& obs, const std::vector<GnssIngest*>& pickers);
+
 }  // namespace sensors
 }  // namespace picker_localisation
