@@ -806,6 +806,14 @@ TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
   // The tag is now more likely 4 m from the antenna than next to it.
   EXPECT_GT(likelihoodAt(*second.observation, nodeAt(*map, 4, 0)),
             likelihoodAt(*second.observation, nodeAt(*map, 0, 0)));
+  // After the clock jumped back (reset), a read 2 s after a "previous" one is a first read again: no failed
+  // attempts are counted across the jump.
+  rfid.reset();
+  read.stamp = 1.5;
+  const RfidResult after_reset = rfid.process(read);
+  ASSERT_TRUE(after_reset.accepted());
+  EXPECT_NEAR(likelihoodAt(*after_reset.observation, nodeAt(*map, 0, 0)), p0, 1e-9);
+  read.stamp = 3.0;  // restore the sequence the rest of the test expects
   // attempt_rate 0: reads only (the former model).
   o.attempt_rate = 0.0;
   RfidObservationModel plain(twoPickers(), map, o);

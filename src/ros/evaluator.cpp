@@ -127,6 +127,18 @@ void Evaluator::sampleAt(double t) {
 }
 
 void Evaluator::onTimer(const ros::TimerEvent&) {
+  if (clock_guard_.clockJumpedBack()) {
+    // A looping bag or a restarted simulator: sample the new time line from its first ground truth (the errors
+    // scored so far are kept).
+    ROS_WARN("evaluator: the clock jumped back: sampling restarts with the next ground truth");
+    first_truth_ = next_sample_ = -1.0;
+    for (Picker& p : pickers_) {
+      p.belief_history.clear();
+      p.truth_history.clear();
+      p.truth.reset();
+      p.estimated_node.reset();
+    }
+  }
   if (done_ || first_truth_ < 0.0) return;
   const double now = ros::Time::now().toSec();
   if (next_sample_ < 0.0) next_sample_ = std::ceil(first_truth_ / sample_period_) * sample_period_;

@@ -179,6 +179,12 @@ std::optional<topology::NodeIndex> NbsPlannerNode::robotNode() {
 }
 
 void NbsPlannerNode::planOnce() {
+  if (clock_guard_.clockJumpedBack()) {
+    // Peer goals stamped in the old time would never age out (claim_timeout counts forward).
+    ROS_WARN("nbs_planner: the clock jumped back: peer goals and the last plan forgotten");
+    peer_goals_.clear();
+    last_plan_.reset();
+  }
   const ros::Time stamp = ros::Time::now();
   const auto robot = robotNode();
   if (!robot) {

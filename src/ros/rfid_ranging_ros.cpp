@@ -41,6 +41,10 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
+  if (stamp_guard_.clockJumpedBack()) {
+    ROS_WARN("rfid_ranging: the clock jumped back: read histories reset");
+    model_->reset();
+  }
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {  // adopting it would reject every later read
     ROS_WARN_THROTTLE(5.0, "rfid_ranging: read stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       msg->header.stamp.toSec(), stamp_guard_.maxFuture());
@@ -82,6 +86,7 @@ void RfidRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
   stat.add("stamped in the future (dropped)", stamp_guard_.futureStamps());
+  stat.add("clock jumps back", stamp_guard_.jumps());
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

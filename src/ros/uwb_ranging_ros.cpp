@@ -87,6 +87,12 @@ std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, 
 }
 
 void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
+  if (stamp_guard_.clockJumpedBack()) {
+    ROS_WARN("uwb_ranging: the clock jumped back: tag filters reset");
+    uwb_->reset();
+    have_range_ = false;
+    newest_stamp_ = 0.0;
+  }
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     ROS_WARN_THROTTLE(5.0, "uwb_ranging: range stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       msg->header.stamp.toSec(), stamp_guard_.maxFuture());
@@ -170,6 +176,7 @@ void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("received", c.received + tf_failures_);
   stat.add("accepted", c.accepted);
   stat.add("stamped in the future (dropped)", stamp_guard_.futureStamps());
+  stat.add("clock jumps back", stamp_guard_.jumps());
   stat.add("dropped: no tf", tf_failures_);
   stat.add("rejected: unknown tag", c.unknown_tag);
   stat.add("rejected: not finite", c.not_finite);

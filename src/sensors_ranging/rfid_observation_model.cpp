@@ -155,6 +155,13 @@ std::vector<topology::NodeIndex> RfidObservationModel::nodesInReadRegion(const E
   return nodes;
 }
 
+void RfidObservationModel::reset() {
+  antenna_last_stamp_.clear();
+  antenna_session_start_.clear();
+  last_read_.clear();
+  last_negative_.clear();
+}
+
 RfidResult RfidObservationModel::process(const RfidRead& read) {
   RfidResult result;
   ++counters_.received;

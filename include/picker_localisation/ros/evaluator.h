@@ -15,6 +15,8 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
+
+#include "picker_localisation/ros/stamp_guard.h"
 #include <ros/ros.h>
 
 #include <deque>
@@ -64,6 +66,7 @@ class Evaluator {
   double first_truth_ = -1.0;  // ROS time of the first ground truth, s
   double sample_period_ = 1.0, ordering_latency_ = 1.5;
   double next_sample_ = -1.0;  // next grid time t_k to sample, s
+  StampGuard clock_guard_;     // jump-back detection only
   void sampleAt(double t);
   std::string output_csv_;
   ros::Timer timer_;

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
 namespace picker_localisation {
@@ -79,6 +80,7 @@ class NbsPlannerNode {
   std::vector<std::unique_ptr<PickerInput>> pickers_;
   std::vector<ros::Subscriber> peer_subs_;
   std::map<std::string, PeerGoal> peer_goals_;
+  StampGuard clock_guard_;  // jump-back detection only
   ros::Subscriber battery_sub_;
   ros::Publisher goal_pub_, marker_pub_;
   ros::ServiceServer candidates_srv_;

@@ -108,6 +108,8 @@ class RfidObservationModel {
                        RfidModelOptions options = {});
 
   RfidResult process(const RfidRead& read);
+  // Forgets every time state (read spells, last reads, failed attempts): after the clock jumped back.
+  void reset();
   // Map nodes inside the read region of an antenna at pose (x, y, yaw), sorted: within regionRadius() (and the
   // beam).
   std::vector<topology::NodeIndex> nodesInReadRegion(const Eigen::Vector3d& antenna_pose) const;

@@ -97,6 +97,8 @@ class UwbRanging {
   void flush(double now, std::vector<core::Observation>* out);
 
   const UwbCounters& counters() const { return counters_; }
+  // Forgets every tag's batch and filter (after the clock jumped back); counters stay.
+  void reset() { tags_.clear(); }
   const RangeHistogramFilter* filter(const std::string& tag_id) const;  // nullptr before the tag's first update
   const UwbRangingOptions& options() const { return options_; }
 
