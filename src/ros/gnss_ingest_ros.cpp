@@ -65,10 +65,11 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
           [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(m, i); }));
     ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
   }
-  if (o.association.enabled && !person_topic.empty()) {
+  if (!person_topic.empty()) {  // with associate_people false the people are passed on unchanged
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
-    ROS_INFO("gnss_ingest: associating anonymous people from %s with the pickers", person_topic.c_str());
+    ROS_INFO("gnss_ingest: %s anonymous people from %s", o.association.enabled ? "associating" : "passing on",
+             person_topic.c_str());
   }
   if (!o.bias.sighting_sensors.empty())
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
