@@ -70,11 +70,14 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   return "";
 }
 
+bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
+                    const std::string& picker_id) {
+  if (identifying) return identified == picker_id;
+  return candidates.empty() || std::find(candidates.begin(), candidates.end(), picker_id) != candidates.end();
+}
+
 bool concernsPicker(const Observation& obs, const std::string& picker_id) {
-  if (obs.identifying) return obs.picker_id == picker_id;
-  return obs.candidate_pickers.empty() ||
-         std::find(obs.candidate_pickers.begin(), obs.candidate_pickers.end(), picker_id) !=
-             obs.candidate_pickers.end();
+  return concernsPicker(obs.identifying, obs.picker_id, obs.candidate_pickers, picker_id);
 }
 
 }  // namespace core

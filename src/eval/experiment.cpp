@@ -555,9 +555,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
           const sensors::GnssBiasEstimator& b = tracks[i].gnss->bias();
           BiasSample bs;
           bs.sighting_age = b.sighted() ? next_sample - b.lastSighting() : std::numeric_limits<double>::infinity();
-          bs.residual = (tracks[i].true_gnss_error -
-                         (b.usable(next_sample) ? b.bias(next_sample) : Eigen::Vector2d::Zero()))
-                            .norm();
+          bs.residual = (tracks[i].true_gnss_error - b.applied(next_sample)).norm();
           bs.lane_applicable = result.samples.back().lane_applicable;
           bs.in_true_lane = result.samples.back().in_true_lane;
           result.bias_samples.push_back(bs);

@@ -152,8 +152,8 @@ void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& 
 }
 
 void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
-  const auto& sensors = options_.bias.sighting_sensors;
-  if (!msg->identifying || std::find(sensors.begin(), sensors.end(), msg->sensor) == sensors.end()) return;
+  // Cheap filter before converting: this topic carries every observation of the fleet.
+  if (!msg->identifying || !options_.bias.isSightingSensor(msg->sensor)) return;
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;
   Input in;
@@ -231,8 +231,8 @@ void GnssIngestNode::publishBias(std::size_t i, double stamp, const sensors::Gns
   const sensors::GnssIngest& g = ingest_[i];
   const sensors::GnssBiasEstimator& b = g.bias();
   const bool used = b.usable(stamp);
-  const Eigen::Vector2d bias = used ? b.bias(stamp) : Eigen::Vector2d::Zero();
-  const Eigen::Matrix2d cov = used ? b.covariance(stamp) : sensors::GnssBiasEstimator(options_.bias).covariance(stamp);
+  const Eigen::Vector2d bias = b.applied(stamp);
+  const Eigen::Matrix2d cov = b.appliedCovariance(stamp);
   picker_localisation::GnssBias m;
   m.header.stamp.fromSec(std::max(0.0, stamp));
   m.header.frame_id = frame_id_;

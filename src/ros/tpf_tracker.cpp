@@ -218,11 +218,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_
 
 void TpfTracker::observationCallback(const picker_localisation::Observation::ConstPtr& msg) {
   ++received_;
-  const bool ours = msg->identifying ? msg->picker_id == picker_id_
-                                     : msg->candidate_pickers.empty() ||
-                                           std::find(msg->candidate_pickers.begin(), msg->candidate_pickers.end(),
-                                                     picker_id_) != msg->candidate_pickers.end();
-  if (!ours) {
+  if (!core::concernsPicker(msg->identifying, msg->picker_id, msg->candidate_pickers, picker_id_)) {
     ++other_picker_;  // another picker's (identifying, or an anonymous one this picker cannot be)
     return;
   }

@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -59,6 +60,14 @@ std::string GnssBiasOptions::validate() const {
   return "";
 }
 
+Eigen::Matrix2d GnssBiasOptions::priorCovariance() const {
+  return Eigen::Matrix2d::Identity() * (offset_std * offset_std + drift_std * drift_std);
+}
+
+bool GnssBiasOptions::isSightingSensor(const std::string& sensor) const {
+  return std::find(sighting_sensors.begin(), sighting_sensors.end(), sensor) != sighting_sensors.end();
+}
+
 GnssBiasEstimator::GnssBiasEstimator(GnssBiasOptions options) : options_(options) {
   const std::string problem = options_.validate();
   if (!problem.empty()) throw std::invalid_argument("GnssBiasEstimator: " + problem);
@@ -107,6 +116,14 @@ Eigen::Matrix2d GnssBiasEstimator::covariance(double t) const {
 
 bool GnssBiasEstimator::usable(double t) const {
   return options_.enabled && sighted() && t - last_ <= options_.max_age;
+}
+
+Eigen::Vector2d GnssBiasEstimator::applied(double t) const {
+  return usable(t) ? bias(t) : Eigen::Vector2d::Zero();
+}
+
+Eigen::Matrix2d GnssBiasEstimator::appliedCovariance(double t) const {
+  return usable(t) ? covariance(t) : options_.priorCovariance();
 }
 
 BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const Eigen::Matrix2d& R) {

@@ -301,14 +301,9 @@ GnssIngest::Prediction GnssIngest::predictPosition(double t, double speed, doubl
   if (!last_ || std::abs(t - last_->stamp) > max_age) return pr;
   pr.valid = true;
   const double r = options_.bias.residual_std, m = speed * std::abs(t - last_->stamp);
-  // Before any sighting (or with the estimate disabled) the bias is unknown: its prior covariance.
-  const GnssBiasOptions& bo = options_.bias;
-  const bool corrected = bias_.usable(t);
-  pr.mean = corrected ? Eigen::Vector2d(last_->position - bias_.bias(t)) : last_->position;
-  const Eigen::Matrix2d bias_cov =
-      corrected ? bias_.covariance(t)
-                : Eigen::Matrix2d(Eigen::Matrix2d::Identity() * (bo.offset_std * bo.offset_std + bo.drift_std * bo.drift_std));
-  pr.covariance = bias_cov + (r * r + m * m) * Eigen::Matrix2d::Identity();
+  // Before any sighting (or with the estimate disabled) the bias is unknown: zero, with its prior covariance.
+  pr.mean = last_->position - bias_.applied(t);
+  pr.covariance = bias_.appliedCovariance(t) + (r * r + m * m) * Eigen::Matrix2d::Identity();
   return pr;
 }
 

@@ -2,7 +2,6 @@
 
 #include <Eigen/LU>
 
-#include <algorithm>
 #include <cmath>
 
 namespace picker_localisation {
@@ -107,8 +106,7 @@ bool addIdentifyingSighting(const core::Observation& obs, const std::vector<Gnss
     return false;
   for (GnssIngest* g : pickers) {
     if (g->pickerId() != obs.picker_id) continue;
-    const auto& sensors = g->options().bias.sighting_sensors;
-    if (std::find(sensors.begin(), sensors.end(), obs.sensor) == sensors.end()) return false;
+    if (!g->options().bias.isSightingSensor(obs.sensor)) return false;
     return g->addSighting(obs.stamp, *obs.position, obs.position_covariance).accepted;
   }
   return false;

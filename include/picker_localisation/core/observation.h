@@ -36,6 +36,9 @@ struct Observation {
 // True when the observation is for `picker_id`'s filter: its identified picker, or (not identifying) one of its
 // candidate pickers, or every picker when it names none.
 bool concernsPicker(const Observation& obs, const std::string& picker_id);
+// The same rule on the fields (for a message, before converting it).
+bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
+                    const std::string& picker_id);
 
 // Options of a Gaussian node likelihood.
 struct GaussianLikelihoodOptions {

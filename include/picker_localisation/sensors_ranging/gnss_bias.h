@@ -57,6 +57,9 @@ struct GnssBiasOptions {
   static GnssBiasOptions fromYaml(const YAML::Node& node);
   static const std::vector<std::string>& yamlKeys();
   std::string validate() const;  // "" or "<key> = <value>: must be ..."
+  // Covariance of the bias before any sighting: (offset_std^2 + drift_std^2) I.
+  Eigen::Matrix2d priorCovariance() const;
+  bool isSightingSensor(const std::string& sensor) const;  // sensor is in sighting_sensors
 };
 
 // The outcome of one sighting.
@@ -79,6 +82,10 @@ class GnssBiasEstimator {
   Eigen::Matrix2d covariance(double t) const;
   // True after the first accepted sighting and while t - lastSighting() <= max_age.
   bool usable(double t) const;
+  // What fixes at time t have removed and its uncertainty: bias(t) and covariance(t) while usable(t), else zero
+  // and the prior covariance (the bias is unknown).
+  Eigen::Vector2d applied(double t) const;
+  Eigen::Matrix2d appliedCovariance(double t) const;
   bool sighted() const { return sightings_ > 0; }
   double lastSighting() const { return last_; }
   std::size_t sightings() const { return sightings_; }
