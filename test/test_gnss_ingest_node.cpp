@@ -5,6 +5,7 @@
 #include <sensor_msgs/NavSatFix.h>
 
 #include <picker_localisation/GnssBias.h>
+#include <picker_localisation/PickerList.h>
 
 #include <cmath>
 
@@ -126,7 +127,9 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
   EXPECT_EQ(lidar(true), 6u);
   EXPECT_EQ(lidar(false), 0u);
   for (const auto& o : c.obs)
-    if (o.sensor == "lidar" && o.identifying) EXPECT_EQ(o.picker_id, "picker_3");
+    if (o.sensor == "lidar" && o.identifying) {
+      EXPECT_EQ(o.picker_id, "picker_3");
+    }
   EXPECT_FALSE(bias.front().estimated);  // the first fix came before any sighting
   const pl::GnssBias& last = bias.back();
   EXPECT_TRUE(last.estimated);
@@ -149,6 +152,48 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
       5.0))
       << c.diag["picker_3 bias sightings accepted/refused"] << "; people "
       << c.diag["people received / identified / nobody's / malformed"];
+}
+
+// Issue "Track a whole farm": gnss_ingest follows the tracker's picker list (/pickers/registry): a picker
+// added at run time has its fixes ingested, one removed is no longer subscribed.
+TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
+  namespace pl = picker_localisation;
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "GNSS ingestion");
+  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  ros::Publisher registry = nh.advertise<pl::PickerList>("/pickers/registry", 1, true);
+  ros::Publisher fix4 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_4/fix", 20);
+  ros::Publisher fix1 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 20);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return registry.getNumSubscribers() > 0 && fix1.getNumSubscribers() > 0; }, 30.0));
+  EXPECT_EQ(fix4.getNumSubscribers(), 0u);  // not in the pickers file
+  auto info = [](const std::string& id, const std::string& topic) {
+    pl::PickerInfo p;
+    p.id = id;
+    p.gnss_topic = topic;
+    return p;
+  };
+  pl::PickerList list;
+  list.pickers = {info("picker_1", "/pickers/picker_1/fix"), info("picker_4", "/pickers/picker_4/fix"),
+                  info("bad-id", "/pickers/bad/fix")};
+  registry.publish(list);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() > 0; }, 10.0)) << "picker_4 not subscribed";
+  ranging_test::spinFor(0.3);
+  const std::size_t before = c.obs.size();
+  fix4.publish(fixAt(datum, Eigen::Vector2d(20.0, -20.0), ros::Time::now()));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return ranging_test::countFor(c.obs, "picker_4") == 1; }, 10.0));
+  EXPECT_GT(c.obs.size(), before);
+  // picker_2 and picker_3 are not in the list: no longer subscribed. An empty list removes everyone.
+  ros::Publisher fix2 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_2/fix", 20);
+  ranging_test::spinFor(1.0);
+  EXPECT_EQ(fix2.getNumSubscribers(), 0u);
+  list.pickers.clear();
+  registry.publish(list);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() == 0 && fix1.getNumSubscribers() == 0; }, 10.0));
+  // Back to the file's three pickers for any later test.
+  list.pickers = {info("picker_1", "/pickers/picker_1/fix"), info("picker_2", "/pickers/picker_2/fix"),
+                  info("picker_3", "/pickers/picker_3/fix")};
+  registry.publish(list);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return fix1.getNumSubscribers() > 0; }, 10.0));
 }
 
 int main(int argc, char** argv) {

@@ -1,14 +1,18 @@
-// rostest of tpf_tracker (three trackers from test/data/tpf_test_pickers.yaml via launch/trackers.launch):
-// beliefs / estimates / markers on observations, another picker's identifying observations ignored,
-// non-identifying ones reaching every tracker, periodic prediction, what-if leaving the live filter alone,
-// reset, and bad input.
+// rostest of tpf_tracker (one node, the three pickers of test/data/tpf_test_pickers.yaml, via
+// launch/trackers.launch): beliefs / estimates / markers on observations, another picker's identifying
+// observations ignored, non-identifying ones reaching every filter, periodic prediction, what-if leaving the
+// live filter alone, reset, bad input; pickers added and removed at run time (and bad requests refused).
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <picker_localisation/AddPicker.h>
+#include <picker_localisation/ListPickers.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerList.h>
+#include <picker_localisation/RemovePicker.h>
 #include <picker_localisation/ResetBelief.h>
 #include <picker_localisation/WhatIf.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -51,10 +55,10 @@ class TrackerTest : public ::testing::Test {
           }));
       ASSERT_TRUE(ros::service::waitForService("/pickers/" + id + "/what_if", ros::Duration(60.0))) << id;
     }
-    // Wait until every tracker is subscribed to /observations.
+    // One node tracks every picker: one subscription to /observations.
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
-    while (pub_.getNumSubscribers() < 3 && ros::WallTime::now() < until) ros::WallDuration(0.05).sleep();
-    ASSERT_GE(pub_.getNumSubscribers(), 3u);
+    while (pub_.getNumSubscribers() < 1 && ros::WallTime::now() < until) ros::WallDuration(0.05).sleep();
+    ASSERT_EQ(pub_.getNumSubscribers(), 1u);
     spinFor(0.5);  // latched messages of the start
   }
 
@@ -248,6 +252,100 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
   send(observationAt(node_b, "gnss", "picker_1"));
   ASSERT_TRUE(waitFor([&] { return topics_["picker_1"].beliefs.back().observations == 1; }));
   EXPECT_LE(hops(topics_["picker_1"].beliefs.back().estimated_node, node_b), 1);
+}
+
+std::vector<std::string> listedIds(ros::NodeHandle& nh) {
+  picker_localisation::ListPickers list;
+  std::vector<std::string> ids;
+  if (!ros::service::call("/tpf_tracker/list_pickers", list)) return {"<list_pickers failed>"};
+  for (const auto& p : list.response.pickers) ids.push_back(p.id);
+  return ids;
+}
+
+TEST_F(TrackerTest, PickersAddedAndRemovedAtRunTime) {
+  const std::vector<std::string> initial{"picker_1", "picker_2", "picker_3"};
+  ASSERT_TRUE(ros::service::waitForService("/tpf_tracker/add_picker", ros::Duration(30.0)));
+  EXPECT_EQ(listedIds(nh_), initial);
+  std::vector<picker_localisation::PickerList> lists;
+  ros::Subscriber registry = nh_.subscribe<picker_localisation::PickerList>(
+      "/pickers/registry", 10, [&](const picker_localisation::PickerList::ConstPtr& m) { lists.push_back(*m); });
+  ASSERT_TRUE(waitFor([&] { return !lists.empty(); }, 5.0)) << "/pickers/registry is not latched";
+  EXPECT_EQ(lists.back().pickers.size(), 3u);
+
+  // Bad requests: a clear message, nothing changes.
+  auto request = [](const std::string& id, std::vector<std::string> rfid = {}, const std::string& gnss = "",
+                    const std::string& overrides = "") {
+    picker_localisation::AddPicker a;
+    a.request.picker.id = id;
+    a.request.picker.rfid_tags = std::move(rfid);
+    a.request.picker.gnss_topic = gnss;
+    a.request.tpf_overrides = overrides;
+    return a;
+  };
+  struct Bad {
+    picker_localisation::AddPicker call;
+    const char* says;  // a word the refusal must contain
+  };
+  std::vector<Bad> bad{{request(""), "empty"},
+                       {request("9lives"), "letter"},
+                       {request("bad-id"), "letters, digits"},
+                       {request("picker_1"), "duplicate"},
+                       {request("picker_9", {"rfid_0001"}), "rfid_0001"},
+                       {request("picker_9", {""}), "empty RFID"},
+                       {request("picker_9", {}, "not a topic"), "gnss_topic"},
+                       {request("picker_9", {}, "", "{num_particles: 0}"), "num_particles"},
+                       {request("picker_9", {}, "", "[1, 2]"), "mapping"}};
+  for (auto& b : bad) {
+    ASSERT_TRUE(ros::service::call("/tpf_tracker/add_picker", b.call)) << b.call.request.picker.id;
+    EXPECT_FALSE(b.call.response.success) << b.call.request.picker.id << " " << b.says;
+    EXPECT_NE(b.call.response.message.find(b.says), std::string::npos) << b.call.response.message;
+  }
+  EXPECT_EQ(listedIds(nh_), initial);
+  EXPECT_FALSE(ros::service::exists("/pickers/picker_9/what_if", false));
+
+  // A good one: its own filter (its overrides), topics and services, reached only by its observations.
+  auto add = request("picker_4", {"rfid_0004"}, "/pickers/picker_4/fix", "{num_particles: 200}");
+  ASSERT_TRUE(ros::service::call("/tpf_tracker/add_picker", add));
+  ASSERT_TRUE(add.response.success) << add.response.message;
+  EXPECT_EQ(listedIds(nh_), (std::vector<std::string>{"picker_1", "picker_2", "picker_3", "picker_4"}));
+  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 4u; }, 5.0));
+  EXPECT_EQ(lists.back().pickers.back().gnss_topic, "/pickers/picker_4/fix");
+  ASSERT_TRUE(ros::service::waitForService("/pickers/picker_4/what_if", ros::Duration(5.0)));
+  std::vector<PickerBelief> beliefs4;
+  ros::Subscriber sub4 = nh_.subscribe<PickerBelief>(
+      "/pickers/picker_4/belief", 20, [&](const PickerBelief::ConstPtr& m) { beliefs4.push_back(*m); });
+  ASSERT_TRUE(waitFor([&] { return sub4.getNumPublishers() > 0; }, 5.0));
+  spinFor(0.3);
+  const std::string node_b = farNodes(*map_).second;
+  const std::uint32_t p1 = topics_["picker_1"].beliefs.empty() ? 0 : topics_["picker_1"].beliefs.back().observations;
+  send(observationAt(node_b, "rfid", "picker_4"));
+  ASSERT_TRUE(waitFor([&] { return !beliefs4.empty() && beliefs4.back().observations == 1; }));
+  EXPECT_EQ(beliefs4.back().particle_count, 200u);
+  EXPECT_LE(hops(beliefs4.back().estimated_node, node_b), 1);
+  spinFor(0.3);
+  if (!topics_["picker_1"].beliefs.empty()) {
+    EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, p1);
+  }
+
+  // Removal: unknown ids refused; the picker's services go, the others stay.
+  picker_localisation::RemovePicker unknown;
+  unknown.request.id = "picker_9";
+  ASSERT_TRUE(ros::service::call("/tpf_tracker/remove_picker", unknown));
+  EXPECT_FALSE(unknown.response.success);
+  EXPECT_NE(unknown.response.message.find("picker_9"), std::string::npos);
+  picker_localisation::RemovePicker remove;
+  remove.request.id = "picker_4";
+  ASSERT_TRUE(ros::service::call("/tpf_tracker/remove_picker", remove));
+  EXPECT_TRUE(remove.response.success) << remove.response.message;
+  EXPECT_EQ(listedIds(nh_), initial);
+  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 3u; }, 5.0));
+  EXPECT_FALSE(ros::service::exists("/pickers/picker_4/what_if", false));
+  EXPECT_TRUE(ros::service::exists("/pickers/picker_1/what_if", false));
+  // Added again, it starts afresh.
+  auto again = request("picker_4");
+  ASSERT_TRUE(ros::service::call("/tpf_tracker/add_picker", again));
+  EXPECT_TRUE(again.response.success) << again.response.message;
+  EXPECT_EQ(listedIds(nh_).size(), 4u);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -16,13 +17,25 @@ namespace {
 }
 }  // namespace
 
+std::string pickerIdProblem(const std::string& id) {
+  if (id.empty()) return "the id is empty";
+  if (!std::isalpha(static_cast<unsigned char>(id[0])))
+    return "id '" + id + "' must start with a letter (it names topics /pickers/<id>/...)";
+  for (char c : id)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
+      return "id '" + id + "' may hold only letters, digits and '_' (it names topics /pickers/<id>/...)";
+  return "";
+}
+
 PickerRegistry::PickerRegistry(std::vector<PickerConfig> pickers, const std::string& source)
     : pickers_(std::move(pickers)) {
   std::unordered_map<std::string, std::string> ids, rfid, uwb;
   for (const PickerConfig& p : pickers_) {
-    if (p.id.empty()) fail(source, "a picker has an empty id (field 'id')");
+    const std::string id_problem = pickerIdProblem(p.id);
+    if (!id_problem.empty()) fail(source, id_problem + " (field 'id')");
     if (!ids.emplace(p.id, p.id).second) fail(source, "duplicate picker id '" + p.id + "' (field 'id')");
     for (const std::string& t : p.rfid_tags) {
+      if (t.empty()) fail(source, "picker '" + p.id + "' has an empty RFID tag (field 'rfid_tags')");
       auto [it, fresh] = rfid.emplace(t, p.id);
       if (!fresh) fail(source, "RFID tag '" + t + "' belongs to both '" + it->second + "' and '" + p.id + "' (field 'rfid_tags')");
     }
@@ -53,6 +66,10 @@ PickerRegistry PickerRegistry::parse(const std::string& yaml_text, const std::st
       p.id = e["id"].as<std::string>();
       if (e["gnss_topic"] && !e["gnss_topic"].IsNull()) p.gnss_topic = e["gnss_topic"].as<std::string>();
       if (e["uwb_tag"] && !e["uwb_tag"].IsNull()) p.uwb_tag = e["uwb_tag"].as<std::string>();
+      if (e["tpf"] && !e["tpf"].IsNull()) {
+        if (!e["tpf"].IsMap()) fail(source, where + " ('" + p.id + "'): 'tpf' must be a mapping of config/tpf.yaml keys");
+        p.tpf_overrides = YAML::Dump(e["tpf"]);
+      }
       if (e["rfid_tags"] && !e["rfid_tags"].IsNull()) {
         if (e["rfid_tags"].IsScalar())
           p.rfid_tags.push_back(e["rfid_tags"].as<std::string>());
@@ -92,6 +109,22 @@ std::optional<std::string> PickerRegistry::pickerForUwbTag(const std::string& ta
   for (const PickerConfig& p : pickers_)
     if (!p.uwb_tag.empty() && p.uwb_tag == tag) return p.id;
   return std::nullopt;
+}
+
+void PickerRegistry::add(PickerConfig picker) {
+  const std::string source = "picker '" + picker.id + "'";
+  std::vector<PickerConfig> all = pickers_;
+  all.push_back(std::move(picker));
+  *this = PickerRegistry(std::move(all), source);
+}
+
+bool PickerRegistry::remove(const std::string& id) {
+  for (auto it = pickers_.begin(); it != pickers_.end(); ++it)
+    if (it->id == id) {
+      pickers_.erase(it);
+      return true;
+    }
+  return false;
 }
 
 std::vector<std::string> PickerRegistry::ids() const {

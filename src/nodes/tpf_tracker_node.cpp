@@ -1,4 +1,5 @@
-// tpf_tracker: one picker's Topological Particle Filter (see include/picker_localisation/ros/tpf_tracker.h).
+// tpf_tracker: every picker's Topological Particle Filter in one node (see
+// include/picker_localisation/ros/tpf_tracker.h).
 #include <ros/ros.h>
 
 #include "picker_localisation/ros/tpf_tracker.h"

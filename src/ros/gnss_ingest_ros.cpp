@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include <ros/names.h>
+
 #include <picker_localisation/GnssBias.h>
 
 #include "picker_localisation/ros/map_source.h"
@@ -15,7 +17,7 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
+GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
@@ -24,9 +26,8 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     ROS_FATAL("gnss_ingest: parameter ~datum_file (config/datum.yaml) is required");
     return;
   }
-  std::unique_ptr<sensors::GeodeticDatum> datum;
   try {
-    datum = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
+    datum_ = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
   } catch (const std::exception& e) {
     ROS_FATAL("gnss_ingest: %s", e.what());
     return;
@@ -42,29 +43,20 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (!map_) return;
 
   options_ = o;
-  std::string topic, person_topic, belief_prefix, bias_prefix;
+  std::string topic, person_topic, registry_topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
-  pnh.param<std::string>("belief_topic_prefix", belief_prefix, "/pickers");
-  pnh.param<std::string>("bias_topic_prefix", bias_prefix, "/pickers");
-  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
-  ordering_ = core::StampOrderedBuffer<Input>(std::max(0.0, ordering_latency_));
-  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  pnh.param<std::string>("belief_topic_prefix", belief_prefix_, "/pickers");
+  pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
+  pnh.param<std::string>("registry_topic", registry_topic, "/pickers/registry");
+  ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
+  ordering_ = core::StampOrderedBuffer<Input>(ordering_latency_, 10000 + 20 * registry.size());
+  pub_ = nh.advertise<picker_localisation::Observation>(topic, 1000);
   markers_pub_ = pnh.advertise<visualization_msgs::MarkerArray>("bias_markers", 2, true);
-  for (const core::PickerConfig& p : registry.pickers()) {
-    if (p.gnss_topic.empty()) continue;
-    ingest_.emplace_back(p.id, map_, *datum, o);
-    beliefs_.emplace_back();
-    const std::size_t i = ingest_.size() - 1;
-    subs_.push_back(nh.subscribe<sensor_msgs::NavSatFix>(
-        p.gnss_topic, 50, [this, i](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, i); }));
-    bias_pubs_.push_back(nh.advertise<picker_localisation::GnssBias>(bias_prefix + "/" + p.id + "/gnss_bias", 5, true));
-    if (o.association.enabled && o.association.belief_weight > 0.0)
-      subs_.push_back(nh.subscribe<picker_localisation::PickerBelief>(
-          belief_prefix + "/" + p.id + "/belief", 20,
-          [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(m, i); }));
-    ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
-  }
+  for (const core::PickerConfig& p : registry.pickers()) addPicker(p);
+  if (!registry_topic.empty())
+    subs_.push_back(nh.subscribe<picker_localisation::PickerList>(
+        registry_topic, 2, [this](const picker_localisation::PickerList::ConstPtr& m) { onRegistry(m); }));
   if (!person_topic.empty()) {  // with associate_people false the people are passed on unchanged
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
@@ -77,16 +69,83 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   if (ordering_latency_ > 0.0)
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
                                      [this](const ros::TimerEvent&) { releaseOrdered(); });
-  if (ingest_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
+  if (pickers_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
+  ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
+           ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
   updater_.setHardwareID("gnss_ingest");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
   ok_ = true;
 }
 
+void GnssIngestNode::addPicker(const core::PickerConfig& p) {
+  if (p.gnss_topic.empty()) return;
+  pickers_.push_back(std::make_unique<Picker>(p, map_, *datum_, options_));
+  Picker* raw = pickers_.back().get();
+  by_id_[p.id] = raw;
+  raw->fix_sub = nh_.subscribe<sensor_msgs::NavSatFix>(
+      p.gnss_topic, 50, [this, raw](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, raw); },
+      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+  raw->bias_pub = nh_.advertise<picker_localisation::GnssBias>(bias_prefix_ + "/" + p.id + "/gnss_bias", 5, true);
+  if (options_.association.enabled && options_.association.belief_weight > 0.0)
+    raw->belief_sub = nh_.subscribe<picker_localisation::PickerBelief>(
+        belief_prefix_ + "/" + p.id + "/belief", 20,
+        [this, raw](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(m, raw); });
+  ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
+}
+
+void GnssIngestNode::onRegistry(const picker_localisation::PickerList::ConstPtr& msg) {
+  // The tracker's list is the truth: pickers it no longer tracks go, new ones (with a GNSS topic) come, one whose
+  // topic changed is subscribed again.
+  ++registry_updates_;
+  std::unordered_map<std::string, core::PickerConfig> wanted;
+  std::vector<std::string> order;
+  for (const auto& info : msg->pickers) {
+    core::PickerConfig c;
+    c.id = info.id;
+    c.gnss_topic = info.gnss_topic;
+    c.rfid_tags = info.rfid_tags;
+    c.uwb_tag = info.uwb_tag;
+    std::string error;
+    if (!core::pickerIdProblem(c.id).empty() ||
+        (!c.gnss_topic.empty() && !ros::names::validate(c.gnss_topic, error))) {
+      ROS_WARN("gnss_ingest: picker list entry '%s' ignored: bad id or GNSS topic", c.id.c_str());
+      continue;
+    }
+    if (wanted.emplace(c.id, c).second) order.push_back(c.id);
+  }
+  std::size_t removed = 0, added = 0;
+  for (auto it = pickers_.begin(); it != pickers_.end();) {
+    const auto w = wanted.find((*it)->config.id);
+    if (w == wanted.end() || w->second.gnss_topic != (*it)->config.gnss_topic) {
+      by_id_.erase((*it)->config.id);
+      it = pickers_.erase(it);  // its subscriptions and bias topic go with it
+      ++removed;
+    } else {
+      ++it;
+    }
+  }
+  for (const std::string& id : order)
+    if (!by_id_.count(id) && !wanted[id].gnss_topic.empty()) {
+      addPicker(wanted[id]);
+      ++added;
+    }
+  if (added + removed > 0)
+    ROS_INFO("gnss_ingest: picker list from the tracker: %zu added, %zu removed, %zu with GNSS", added, removed,
+             pickers_.size());
+}
+
+std::vector<const sensors::BeliefHistory*> GnssIngestNode::beliefHistories() const {
+  std::vector<const sensors::BeliefHistory*> out;
+  out.reserve(pickers_.size());
+  for (const auto& p : pickers_) out.push_back(&p->beliefs);
+  return out;
+}
+
 std::vector<sensors::GnssIngest*> GnssIngestNode::pickerPointers() {
   std::vector<sensors::GnssIngest*> pickers;
-  for (auto& g : ingest_) pickers.push_back(&g);
+  pickers.reserve(pickers_.size());
+  for (auto& p : pickers_) pickers.push_back(&p->ingest);
   return pickers;
 }
 
@@ -95,27 +154,29 @@ bool GnssIngestNode::checkClock() {
   // A bag replayed with -l or a simulator restart: forget every picker's fix history, bias estimate, the
   // beliefs and what waits for stamp order (else every later fix would be "not after the last accepted one").
   ROS_WARN("gnss_ingest: the clock jumped back: fix histories, bias estimates and beliefs reset");
-  for (auto& ingest : ingest_) ingest = sensors::GnssIngest(ingest.pickerId(), map_, ingest.datum(), ingest.options());
-  for (auto& b : beliefs_) b.clear();
+  for (auto& p : pickers_) {
+    p->ingest = sensors::GnssIngest(p->config.id, map_, *datum_, options_);
+    p->beliefs.clear();
+  }
   ordering_.clear();
   return true;
 }
 
-void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t i) {
+void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker) {
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix stamped %.3f is more than %.1f s ahead of the clock: rejected",
-                      ingest_[i].pickerId().c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+                      picker->config.id.c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
   }
   Input in;
-  in.picker = i;
+  in.picker = picker->config.id;
   in.fix = gnssFixFromMsg(*msg);
   if (ordering_latency_ <= 0.0 || !std::isfinite(in.fix.stamp)) {
-    processFix(i, in.fix);  // (a NaN stamp is rejected there with its reason)
+    processFix(*picker, in.fix);  // (a NaN stamp is rejected there with its reason)
     return;
   }
-  ordering_.push(in.fix.stamp, "fix|" + ingest_[i].pickerId(), std::move(in));
+  ordering_.push(in.fix.stamp, "fix|" + in.picker, std::move(in));
 }
 
 void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& msg) {
@@ -168,7 +229,7 @@ void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstP
   ordering_.push(in.person.stamp, "sighting|" + msg->sensor + "|" + msg->picker_id + "|" + msg->robot_id, std::move(in));
 }
 
-void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t i) {
+void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, Picker* picker) {
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
   for (std::size_t k = 0; k < msg->nodes.size() && k < msg->masses.size(); ++k) {
@@ -177,14 +238,15 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr&
     nodes.push_back(*n);
     masses.push_back(msg->masses[k]);
   }
-  beliefs_[i].push(msg->header.stamp.toSec(), nodes, masses);
+  picker->beliefs.push(msg->header.stamp.toSec(), nodes, masses);
 }
 
 void GnssIngestNode::releaseOrdered() {
   if (checkClock()) return;
   for (auto& item : ordering_.release(ros::Time::now().toSec())) {
     if (item.second.is_fix) {
-      processFix(item.second.picker, item.second.fix);
+      const auto it = by_id_.find(item.second.picker);
+      if (it != by_id_.end()) processFix(*it->second, item.second.fix);
     } else if (item.second.is_sighting) {
       sensors::addIdentifyingSighting(item.second.person, pickerPointers());
     } else {
@@ -193,8 +255,8 @@ void GnssIngestNode::releaseOrdered() {
   }
 }
 
-void GnssIngestNode::processFix(std::size_t i, const sensors::GnssFix& fix) {
-  sensors::GnssIngest& g = ingest_[i];
+void GnssIngestNode::processFix(Picker& picker, const sensors::GnssFix& fix) {
+  sensors::GnssIngest& g = picker.ingest;
   sensors::GnssResult r = g.process(fix);
   if (!r.accepted()) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(), fix.stamp,
@@ -205,13 +267,13 @@ void GnssIngestNode::processFix(std::size_t i, const sensors::GnssFix& fix) {
     ROS_INFO("gnss_ingest: %s: GNSS back after a %.1f s blackout", g.pickerId().c_str(), r.blackout_ended);
   pub_.publish(toMsg(*r.observation, *map_, frame_id_));
   ++published_;
-  publishBias(i, fix.stamp, r);
+  publishBias(picker, fix.stamp, r);
 }
 
 void GnssIngestNode::processPerson(const core::Observation& person) {
   ++people_;
   const sensors::AssociationResult a = sensors::associatePerson(
-      person, pickerPointers(), sensors::beliefViews(beliefs_, person.stamp, options_.association), *map_,
+      person, pickerPointers(), sensors::beliefViews(beliefHistories(), person.stamp, options_.association), *map_,
       options_.association);
   if (a.picker >= 0) {
     ++identified_;
@@ -227,8 +289,8 @@ void GnssIngestNode::processPerson(const core::Observation& person) {
   ++published_;
 }
 
-void GnssIngestNode::publishBias(std::size_t i, double stamp, const sensors::GnssResult& r) {
-  const sensors::GnssIngest& g = ingest_[i];
+void GnssIngestNode::publishBias(Picker& picker, double stamp, const sensors::GnssResult& r) {
+  const sensors::GnssIngest& g = picker.ingest;
   const sensors::GnssBiasEstimator& b = g.bias();
   const bool used = b.usable(stamp);
   const Eigen::Vector2d bias = b.applied(stamp);
@@ -244,7 +306,7 @@ void GnssIngestNode::publishBias(std::size_t i, double stamp, const sensors::Gns
   m.sighting_age = b.sighted() ? stamp - b.lastSighting() : -1.0;
   m.sightings = static_cast<std::uint32_t>(b.sightings());
   m.refused = static_cast<std::uint32_t>(b.refused());
-  bias_pubs_[i].publish(m);
+  picker.bias_pub.publish(m);
 
   if (markers_pub_.getNumSubscribers() == 0) return;
   visualization_msgs::MarkerArray markers;
@@ -294,7 +356,8 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   std::size_t blackout = 0, rejected = 0;
   stat.add("fixes stamped in the future (rejected)", stamp_guard_.futureStamps());
   stat.add("clock jumps back", stamp_guard_.jumps());
-  for (const sensors::GnssIngest& g : ingest_) {
+  for (const auto& p : pickers_) {
+    const sensors::GnssIngest& g = p->ingest;
     const sensors::GnssCounters& c = g.counters();
     const std::string k = g.pickerId() + " ";
     stat.add(k + "received", c.received);
@@ -314,7 +377,11 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
            std::to_string(people_) + " / " + std::to_string(identified_) + " / " + std::to_string(nobody_) + " / " +
                std::to_string(bad_people_));
   stat.add("waiting for stamp order", ordering_.size());
-  for (const sensors::GnssIngest& g : ingest_) {
+  stat.add("ordering latency (s)", ordering_latency_);
+  stat.add("pickers with GNSS", pickers_.size());
+  stat.add("picker lists received", registry_updates_);
+  for (const auto& p : pickers_) {
+    const sensors::GnssIngest& g = p->ingest;
     const sensors::GnssBiasEstimator& b = g.bias();
     stat.add(g.pickerId() + " bias sightings accepted/refused",
              std::to_string(b.sightings()) + "/" + std::to_string(b.refused()));

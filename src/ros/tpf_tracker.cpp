@@ -1,5 +1,7 @@
 #include "picker_localisation/ros/tpf_tracker.h"
 
+#include <picker_localisation/PickerList.h>
+#include <ros/names.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -31,7 +33,7 @@ std_msgs::ColorRGBA massColour(double relative) {
 
 }  // namespace
 
-tpf::TpfParams tpfParamsFromRos(const ros::NodeHandle& pnh) {
+YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh) {
   YAML::Node merged(YAML::NodeType::Map);
   std::string file;
   if (pnh.getParam("tpf_params_file", file) && !file.empty()) {
@@ -43,6 +45,23 @@ tpf::TpfParams tpfParamsFromRos(const ros::NodeHandle& pnh) {
     if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);
   }
   for (const auto& kv : paramsAsYaml(pnh)) merged[kv.first.as<std::string>()] = kv.second;
+  return merged;
+}
+
+tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides) {
+  YAML::Node merged = YAML::Clone(base);
+  if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);
+  if (!overrides.empty()) {
+    YAML::Node o;
+    try {
+      o = YAML::Load(overrides);
+    } catch (const YAML::Exception& e) {
+      throw std::runtime_error("tpf overrides: YAML syntax error: " + e.msg);
+    }
+    if (!o.IsNull() && !o.IsMap()) throw std::runtime_error("tpf overrides must be a YAML mapping of config/tpf.yaml keys");
+    if (o.IsMap())
+      for (const auto& kv : o) merged[kv.first.as<std::string>()] = kv.second;
+  }
   return tpf::TpfParams::fromYaml(merged);
 }
 
@@ -166,193 +185,382 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& b, const topology::
   return arr;
 }
 
-TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : diagnostics_(nh, pnh) {
-  if (!pnh.getParam("picker_id", picker_id_) || picker_id_.empty()) {
-    ROS_FATAL("tpf_tracker: parameter ~picker_id is required");
+struct TpfTracker::Track {
+  std::string id;
+  std::unique_ptr<tpf::TopologicalParticleFilter> filter;
+  double prediction_period = 0.0;  // s; 0: no periodic prediction
+  ros::Publisher belief_pub, estimate_pub, markers_pub;
+  ros::ServiceServer reset_srv, what_if_srv;
+  std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0;
+  std::string last_problem;
+};
+
+TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
+  std::string pickers_file, single_id;
+  pnh.param<std::string>("pickers_file", pickers_file, "");
+  pnh.param<std::string>("picker_id", single_id, "");
+  try {
+    if (!pickers_file.empty()) {
+      registry_ = core::PickerRegistry::load(pickers_file);
+    } else if (!single_id.empty()) {
+      core::PickerConfig one;
+      one.id = single_id;
+      registry_ = core::PickerRegistry({one}, "~picker_id");
+    } else {
+      ROS_FATAL("tpf_tracker: set ~pickers_file (config/pickers.yaml) or ~picker_id");
+      return;
+    }
+    base_params_ = tpfYamlFromRos(pnh);
+    // The pickers file's and picker_id's keys are this node's, not the filter's.
+    for (const char* own : {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id",
+                            "topic_prefix", "observations_topic", "ordering_latency", "max_future_stamp",
+                            "map_timeout", "map_topic"})
+      base_params_.remove(own);
+    tpf::TpfParams::fromYaml(base_params_);  // a bad shared value is one FATAL line, not one per picker
+  } catch (const std::exception& e) {
+    ROS_FATAL("tpf_tracker: %s", e.what());
     return;
   }
   pnh.param<std::string>("frame_id", frame_id_, "map");
-  tpf::TpfParams params;
-  try {
-    params = tpfParamsFromRos(pnh);
-  } catch (const std::exception& e) {
-    ROS_FATAL("tpf_tracker %s: %s", picker_id_.c_str(), e.what());
-    return;
-  }
-  int seed_param = 0;
-  pnh.param("seed", seed_param, 0);
-  const std::uint64_t seed = seed_param > 0 ? static_cast<std::uint64_t>(seed_param) : seedFromId(picker_id_);
+  pnh.param("seed", seed_param_, 0);
   map_ = obtainMap(nh, pnh);
   if (!map_) return;  // obtainMap logged why
-  filter_ = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
 
-  std::string prefix, observations_topic;
-  pnh.param<std::string>("topic_prefix", prefix, "/pickers");
+  std::string observations_topic;
+  pnh.param<std::string>("topic_prefix", prefix_, "/pickers");
   pnh.param<std::string>("observations_topic", observations_topic, "/observations");
-  const std::string base = prefix + "/" + picker_id_;
-  belief_pub_ = nh.advertise<picker_localisation::PickerBelief>(base + "/belief", 10, true);
-  estimate_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>(base + "/estimate", 10, true);
-  markers_pub_ = nh.advertise<visualization_msgs::MarkerArray>(base + "/markers", 2, true);
-  reset_srv_ = nh.advertiseService(base + "/reset", &TpfTracker::reset, this);
-  what_if_srv_ = nh.advertiseService(base + "/what_if", &TpfTracker::whatIf, this);
-  sub_ = nh.subscribe(observations_topic, 200, &TpfTracker::observationCallback, this);
-  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
+  ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.5);
   stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
-  ordering_ = core::StampOrderedBuffer<std::pair<core::Observation, std::string>>(std::max(0.0, ordering_latency_));
+  ordering_ = core::StampOrderedBuffer<Pending>(ordering_latency_, 10000 + 20 * registry_.size());
+
+  const std::vector<core::PickerConfig> initial = registry_.pickers();
+  for (const core::PickerConfig& p : initial) {
+    std::string error;
+    if (!startTrack(p, &error)) {
+      ROS_FATAL("tpf_tracker: picker %s: %s", p.id.c_str(), error.c_str());
+      return;
+    }
+  }
+  // The deployment's list (from a pickers file) is latched for gnss_ingest; one ~picker_id (tools, tests) names
+  // no GNSS topic, so it publishes none.
+  if (!pickers_file.empty()) {
+    registry_pub_ = nh.advertise<picker_localisation::PickerList>(prefix_ + "/registry", 1, true);
+    publishRegistry();
+  }
+  add_srv_ = pnh.advertiseService("add_picker", &TpfTracker::addPicker, this);
+  remove_srv_ = pnh.advertiseService("remove_picker", &TpfTracker::removePicker, this);
+  list_srv_ = pnh.advertiseService("list_pickers", &TpfTracker::listPickers, this);
+  sub_ = nh.subscribe(observations_topic, 1000, &TpfTracker::observationCallback, this,
+                      ros::TransportHints().tcpNoDelay());
   if (ordering_latency_ > 0.0)
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
-                                     &TpfTracker::orderingCallback, this);
-  if (params.prediction_rate > 0.0) {
-    prediction_period_ = 1.0 / params.prediction_rate;
-    // Ticks at 4x the rate so a prediction happens within a quarter period of falling due.
-    timer_ = nh.createTimer(ros::Duration(prediction_period_ / 4.0), &TpfTracker::timerCallback, this);
-  }
-  diagnostics_.setHardwareID(picker_id_);
-  diagnostics_.add("tpf_tracker " + picker_id_, this, &TpfTracker::diagnose);
+                                     &TpfTracker::orderingTick, this);
+  updatePredictionTimer();
+  diagnostics_.setHardwareID("tpf_tracker");
+  diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
   diagnostics_timer_ =
       nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
-  ROS_INFO("tpf_tracker %s: %zu particles, method %s motion, map '%s' (%zu nodes), prediction every %.1f s",
-           picker_id_.c_str(), params.num_particles, tpf::toString(params.motion_model), map_->name().c_str(),
-           map_->numNodes(), prediction_period_);
+  ROS_INFO("tpf_tracker: %zu picker(s), map '%s' (%zu nodes), ordering latency %.2f s (%s)", tracks_.size(),
+           map_->name().c_str(), map_->numNodes(), ordering_latency_,
+           ordering_latency_ > 0.0 ? "stamp-ordered replay" : "fused on arrival");
+  ok_ = true;
+}
+
+TpfTracker::~TpfTracker() = default;
+
+bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error) {
+  tpf::TpfParams params;
+  try {
+    params = tpfParamsWithOverrides(base_params_, picker.tpf_overrides);
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  auto t = std::make_unique<Track>();
+  Track* raw = t.get();
+  t->id = picker.id;
+  const std::uint64_t seed = seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(picker.id);
+  t->filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
+  t->prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 0.0;
+  const std::string base = prefix_ + "/" + picker.id;
+  t->belief_pub = nh_.advertise<picker_localisation::PickerBelief>(base + "/belief", 10, true);
+  t->estimate_pub = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>(base + "/estimate", 10, true);
+  // Markers are built only for a subscriber (rviz); a new one gets the current markers at once.
+  t->markers_pub = nh_.advertise<visualization_msgs::MarkerArray>(
+      base + "/markers", 2, [this, raw](const ros::SingleSubscriberPublisher& s) {
+        s.publish(toMarkers(raw->filter->belief(), *map_, raw->id, frame_id_));
+      });
+  t->reset_srv = nh_.advertiseService<picker_localisation::ResetBelief::Request, picker_localisation::ResetBelief::Response>(
+      base + "/reset", [this, raw](picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res) {
+        raw->filter->reset();
+        ++raw->resets;
+        res.success = true;
+        res.message = "belief of " + raw->id + " forgotten; the next observation initialises it";
+        publish(*raw);
+        return true;
+      });
+  t->what_if_srv = nh_.advertiseService<picker_localisation::WhatIf::Request, picker_localisation::WhatIf::Response>(
+      base + "/what_if", [this, raw](picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
+        ++raw->what_if_calls;
+        const tpf::TopologicalParticleFilter& f = *raw->filter;
+        if (!std::isfinite(req.horizon) || req.horizon < 0.0) {
+          res.success = false;
+          res.message = "horizon must be finite and >= 0";
+          return true;
+        }
+        tpf::Belief b;
+        if (req.with_observation) {
+          tpf::UpdateResult r;
+          b = f.posteriorUnder(fromMsg(req.observation, *map_), req.horizon, req.seed, &r);
+          if (!r.ok()) {
+            res.success = false;
+            res.message = std::string("hypothetical observation ") + tpf::toString(r.status) + ": " + r.reason;
+            res.belief = toBeliefMsg(b, *map_, raw->id, frame_id_);
+            return true;
+          }
+        } else {
+          if (!f.initialised()) {
+            res.success = false;
+            res.message = "no belief yet: " + raw->id + " has received no observation";
+            res.belief = toBeliefMsg(f.belief(), *map_, raw->id, frame_id_);
+            return true;
+          }
+          b = f.predictAhead(req.horizon, req.seed);
+        }
+        res.success = true;
+        res.belief = toBeliefMsg(b, *map_, raw->id, frame_id_);
+        return true;
+      });
+  diagnostics_.add("tpf_tracker " + picker.id,
+                   [this, raw](diagnostic_updater::DiagnosticStatusWrapper& stat) { diagnose(*raw, stat); });
+  tracks_[picker.id] = std::move(t);
+  publish(*raw);  // "waiting for the first observation": the topic exists from the start
+  ROS_INFO("tpf_tracker %s: %zu particles, method %s motion, prediction every %.1f s", picker.id.c_str(),
+           params.num_particles, tpf::toString(params.motion_model), raw->prediction_period);
+  return true;
+}
+
+void TpfTracker::updatePredictionTimer() {
+  // One timer for every picker, ticking at 4x the fastest prediction rate so a prediction happens within a
+  // quarter period of falling due.
+  double fastest = 0.0;
+  for (const auto& kv : tracks_)
+    if (kv.second->prediction_period > 0.0 && (fastest == 0.0 || kv.second->prediction_period < fastest))
+      fastest = kv.second->prediction_period;
+  if (fastest <= 0.0 || fastest / 4.0 == timer_period_) return;
+  timer_period_ = fastest / 4.0;
+  prediction_timer_ = nh_.createTimer(ros::Duration(timer_period_), &TpfTracker::predictionTick, this);
+}
+
+std::vector<TpfTracker::Track*> TpfTracker::route(bool identifying, const std::string& picker_id,
+                                                  const std::vector<std::string>& candidates) {
+  // core::concernsPicker's rule, by lookup: the picker identified, the candidates, or (anonymous) everyone.
+  std::vector<Track*> out;
+  if (identifying || !candidates.empty()) {
+    for (const std::string& id : identifying ? std::vector<std::string>{picker_id} : candidates) {
+      const auto it = tracks_.find(id);
+      if (it != tracks_.end()) out.push_back(it->second.get());
+    }
+    return out;
+  }
+  out.reserve(tracks_.size());
+  for (auto& kv : tracks_) out.push_back(kv.second.get());
+  return out;
 }
 
 void TpfTracker::observationCallback(const picker_localisation::Observation::ConstPtr& msg) {
   ++received_;
-  if (!core::concernsPicker(msg->identifying, msg->picker_id, msg->candidate_pickers, picker_id_)) {
-    ++other_picker_;  // another picker's (identifying, or an anonymous one this picker cannot be)
+  checkClockJump();
+  const std::vector<Track*> targets = route(msg->identifying, msg->picker_id, msg->candidate_pickers);
+  if (targets.empty()) {
+    ++unrouted_;  // a picker this node does not track
     return;
   }
-  checkClockJump();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     // Adopting it would make every later observation "too old" and start ~(stamp - now) / period predictions.
-    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation stamped %.3f is more than %.1f s ahead of the clock: dropped",
-                      picker_id_.c_str(), msg->sensor.c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker: %s observation for %s stamped %.3f is more than %.1f s ahead of the clock: dropped",
+                      msg->sensor.c_str(), msg->identifying ? msg->picker_id.c_str() : "anyone",
+                      msg->header.stamp.toSec(), stamp_guard_.maxFuture());
     return;
   }
   std::size_t unknown = 0;
-  core::Observation obs = fromMsg(*msg, *map_, &unknown);
-  if (unknown > 0) {
-    unknown_nodes_ += unknown;
-    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %zu node name(s) of a %s observation are not in the map (skipped)",
-                      picker_id_.c_str(), unknown, msg->sensor.c_str());
+  Pending p{fromMsg(*msg, *map_, &unknown), msg->sensor};  // decoded once, whoever it concerns
+  for (Track* t : targets) {
+    ++t->received;
+    t->unknown_nodes += unknown;
   }
+  if (unknown > 0)
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker: %zu node name(s) of a %s observation are not in the map (skipped)", unknown,
+                      msg->sensor.c_str());
   if (ordering_latency_ <= 0.0) {
-    process(obs, msg->sensor);
+    for (Track* t : targets) process(*t, p.obs, p.sensor);
     return;
   }
   // Tie-break equal stamps by content so the fusion order never depends on arrival order.
   std::string key = msg->sensor + "|" + msg->robot_id + "|" + msg->picker_id + "|";
   for (std::size_t i = 0; i < msg->nodes.size() && i < msg->likelihood.size(); ++i)
     key += msg->nodes[i] + ":" + std::to_string(msg->likelihood[i]) + ",";
-  ordering_.push(obs.stamp, key, {std::move(obs), msg->sensor});
+  ordering_.push(p.obs.stamp, key, std::move(p));
+}
+
+void TpfTracker::dispatch(const Pending& p) {
+  // Routed again on release: a picker may have been added or removed while the observation waited.
+  for (Track* t : route(p.obs.identifying, p.obs.picker_id, p.obs.candidate_pickers)) process(*t, p.obs, p.sensor);
 }
 
 void TpfTracker::checkClockJump() {
   if (!stamp_guard_.clockJumpedBack()) return;
-  ROS_WARN("tpf_tracker %s: the clock jumped back: belief reset, %zu waiting observation(s) dropped", picker_id_.c_str(),
-           ordering_.size());
+  ROS_WARN("tpf_tracker: the clock jumped back: %zu belief(s) reset, %zu waiting observation(s) dropped",
+           tracks_.size(), ordering_.size());
   ordering_.clear();
-  filter_->reset();
-  ++resets_;
-  publish();
-}
-
-void TpfTracker::orderingCallback(const ros::TimerEvent&) {
-  checkClockJump();
-  const double now = ros::Time::now().toSec();
-  if (now <= 0.0) return;
-  for (auto& item : ordering_.release(now)) process(item.second.first, item.second.second);
-}
-
-void TpfTracker::predictDueUntil(double until) {
-  if (prediction_period_ <= 0.0) return;
-  int steps = 0;
-  while (filter_->initialised() && until - filter_->lastStamp() >= prediction_period_) {
-    const double next = ++steps < kMaxPredictionsPerCall ? filter_->lastStamp() + prediction_period_
-                                                          : until;  // a long silence: one step to `until`
-    if (!filter_->predictTo(next)) break;
-    publish();
+  for (auto& kv : tracks_) {
+    kv.second->filter->reset();
+    ++kv.second->resets;
+    publish(*kv.second);
   }
 }
 
-void TpfTracker::process(const core::Observation& obs, const std::string& sensor) {
-  if (std::isfinite(obs.stamp)) predictDueUntil(obs.stamp);
-  const tpf::UpdateResult r = filter_->update(obs);
+void TpfTracker::orderingTick(const ros::TimerEvent&) {
+  checkClockJump();
+  const double now = ros::Time::now().toSec();
+  if (now <= 0.0) return;
+  for (auto& item : ordering_.release(now)) dispatch(item.second);
+}
+
+void TpfTracker::predictDueUntil(Track& t, double until) {
+  if (t.prediction_period <= 0.0) return;
+  tpf::TopologicalParticleFilter& f = *t.filter;
+  int steps = 0;
+  while (f.initialised() && until - f.lastStamp() >= t.prediction_period) {
+    const double next = ++steps < kMaxPredictionsPerCall ? f.lastStamp() + t.prediction_period
+                                                          : until;  // a long silence: one step to `until`
+    if (!f.predictTo(next)) break;
+    publish(t);
+  }
+}
+
+void TpfTracker::process(Track& t, const core::Observation& obs, const std::string& sensor) {
+  if (std::isfinite(obs.stamp)) predictDueUntil(t, obs.stamp);
+  const tpf::UpdateResult r = t.filter->update(obs);
   if (!r.ok()) {
     if (r.status != tpf::UpdateStatus::kIgnoredSensor) {
-      last_problem_ = std::string(tpf::toString(r.status)) + ": " + r.reason;
-      ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", picker_id_.c_str(), sensor.c_str(),
-                        last_problem_.c_str());
+      t.last_problem = std::string(tpf::toString(r.status)) + ": " + r.reason;
+      ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", t.id.c_str(), sensor.c_str(), t.last_problem.c_str());
     }
     return;
   }
   if (r.reinitialised)
-    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", picker_id_.c_str(), filter_->belief().jsd);
-  publish();
+    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", t.id.c_str(), t.filter->belief().jsd);
+  publish(t);
 }
 
-void TpfTracker::timerCallback(const ros::TimerEvent&) {
+void TpfTracker::predictionTick(const ros::TimerEvent&) {
   checkClockJump();
   const double now = ros::Time::now().toSec();
-  if (now <= 0.0 || !filter_->initialised()) return;  // sim clock not running yet / nothing to predict
+  if (now <= 0.0) return;  // sim clock not running yet
   // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
-  predictDueUntil(now - std::max(0.0, ordering_latency_));
+  for (auto& kv : tracks_) predictDueUntil(*kv.second, now - ordering_latency_);
 }
 
-bool TpfTracker::reset(picker_localisation::ResetBelief::Request&,
-                       picker_localisation::ResetBelief::Response& res) {
-  filter_->reset();
-  ++resets_;
-  res.success = true;
-  res.message = "belief of " + picker_id_ + " forgotten; the next observation initialises it";
-  publish();
-  return true;
+void TpfTracker::publish(Track& t) {
+  const tpf::Belief& b = t.filter->belief();
+  t.belief_pub.publish(toBeliefMsg(b, *map_, t.id, frame_id_));
+  if (b.initialised) t.estimate_pub.publish(toEstimateMsg(b, *map_, frame_id_));
+  if (t.markers_pub.getNumSubscribers() > 0) t.markers_pub.publish(toMarkers(b, *map_, t.id, frame_id_));
 }
 
-bool TpfTracker::whatIf(picker_localisation::WhatIf::Request& req,
-                        picker_localisation::WhatIf::Response& res) {
-  ++what_if_calls_;
-  if (!std::isfinite(req.horizon) || req.horizon < 0.0) {
-    res.success = false;
-    res.message = "horizon must be finite and >= 0";
+namespace {
+picker_localisation::PickerInfo toInfo(const core::PickerConfig& p) {
+  picker_localisation::PickerInfo m;
+  m.id = p.id;
+  m.gnss_topic = p.gnss_topic;
+  m.rfid_tags = p.rfid_tags;
+  m.uwb_tag = p.uwb_tag;
+  return m;
+}
+}  // namespace
+
+void TpfTracker::publishRegistry() {
+  if (!registry_pub_) return;
+  picker_localisation::PickerList m;
+  m.header.stamp = ros::Time::now();
+  for (const core::PickerConfig& p : registry_.pickers()) m.pickers.push_back(toInfo(p));
+  registry_pub_.publish(m);
+}
+
+bool TpfTracker::addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res) {
+  core::PickerConfig p;
+  p.id = req.picker.id;
+  p.gnss_topic = req.picker.gnss_topic;
+  p.rfid_tags = req.picker.rfid_tags;
+  p.uwb_tag = req.picker.uwb_tag;
+  p.tpf_overrides = req.tpf_overrides;
+  std::string error;
+  if (!p.gnss_topic.empty() && !ros::names::validate(p.gnss_topic, error)) error = "gnss_topic: " + error;
+  core::PickerRegistry updated = registry_;
+  if (error.empty()) {
+    try {
+      updated.add(p);  // id rules, duplicates, tags worn by another picker
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+  if (error.empty()) {
+    try {
+      tpfParamsWithOverrides(base_params_, p.tpf_overrides);
+    } catch (const std::exception& e) {
+      error = std::string("tpf_overrides: ") + e.what();
+    }
+  }
+  if (error.empty()) {
+    registry_ = updated;
+    if (!startTrack(p, &error)) registry_.remove(p.id);  // (parameters checked above: not expected)
+  }
+  res.success = error.empty();
+  if (!res.success) {
+    ++refused_requests_;
+    res.message = "picker '" + p.id + "' not added: " + error;
+    ROS_WARN("tpf_tracker: %s", res.message.c_str());
     return true;
   }
-  tpf::Belief b;
-  if (req.with_observation) {
-    const core::Observation obs = fromMsg(req.observation, *map_);
-    tpf::UpdateResult r;
-    b = filter_->posteriorUnder(obs, req.horizon, req.seed, &r);
-    if (!r.ok()) {
-      res.success = false;
-      res.message = std::string("hypothetical observation ") + tpf::toString(r.status) + ": " + r.reason;
-      res.belief = toBeliefMsg(b, *map_, picker_id_, frame_id_);
-      return true;
-    }
-  } else {
-    if (!filter_->initialised()) {
-      res.success = false;
-      res.message = "no belief yet: " + picker_id_ + " has received no observation";
-      res.belief = toBeliefMsg(filter_->belief(), *map_, picker_id_, frame_id_);
-      return true;
-    }
-    b = filter_->predictAhead(req.horizon, req.seed);
-  }
-  res.success = true;
-  res.belief = toBeliefMsg(b, *map_, picker_id_, frame_id_);
+  ++added_;
+  updatePredictionTimer();
+  publishRegistry();
+  res.message = "tracking " + p.id + " (" + std::to_string(tracks_.size()) + " picker(s))";
+  ROS_INFO("tpf_tracker: %s", res.message.c_str());
   return true;
 }
 
-void TpfTracker::publish() {
-  const tpf::Belief& b = filter_->belief();
-  belief_pub_.publish(toBeliefMsg(b, *map_, picker_id_, frame_id_));
-  if (b.initialised) estimate_pub_.publish(toEstimateMsg(b, *map_, frame_id_));
-  markers_pub_.publish(toMarkers(b, *map_, picker_id_, frame_id_));
+bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
+                              picker_localisation::RemovePicker::Response& res) {
+  const auto it = tracks_.find(req.id);
+  if (it == tracks_.end()) {
+    ++refused_requests_;
+    res.success = false;
+    res.message = "no picker '" + req.id + "' is tracked (list_pickers names them)";
+    return true;
+  }
+  // rviz keeps the last markers of a topic that goes away: delete them first.
+  visualization_msgs::MarkerArray gone = toMarkers(tpf::Belief{}, *map_, req.id, frame_id_);
+  for (auto& m : gone.markers) m.action = visualization_msgs::Marker::DELETE;
+  it->second->markers_pub.publish(gone);
+  diagnostics_.removeByName("tpf_tracker " + req.id);
+  tracks_.erase(it);  // its filter, publishers and services go with it
+  registry_.remove(req.id);
+  ++removed_;
+  publishRegistry();
+  res.success = true;
+  res.message = "stopped tracking " + req.id + " (" + std::to_string(tracks_.size()) + " picker(s) left)";
+  ROS_INFO("tpf_tracker: %s", res.message.c_str());
+  return true;
 }
 
-void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const auto& c = filter_->counters();
-  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old;
-  stat.add("picker_id", picker_id_);
+bool TpfTracker::listPickers(picker_localisation::ListPickers::Request&, picker_localisation::ListPickers::Response& res) {
+  for (const core::PickerConfig& p : registry_.pickers()) res.pickers.push_back(toInfo(p));
+  return true;
+}
+
+void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   // Input rate over the last diagnostics period (wall time: the rate at which this node is fed).
   const ros::WallTime now = ros::WallTime::now();
   if (!last_diag_time_.isZero() && now > last_diag_time_)
@@ -360,36 +568,50 @@ void TpfTracker::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
              static_cast<double>(received_ - last_diag_received_) / (now - last_diag_time_).toSec());
   last_diag_time_ = now;
   last_diag_received_ = received_;
+  stat.add("pickers", tracks_.size());
   stat.add("observations received", received_);
+  stat.add("observations for no tracked picker", unrouted_);
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
-  stat.add("clock jumps back (belief reset)", stamp_guard_.jumps());
+  stat.add("clock jumps back (beliefs reset)", stamp_guard_.jumps());
+  stat.add("ordering latency (s)", ordering_latency_);
   stat.add("observations waiting for stamp order", ordering_.size());
   stat.add("ordering overflows", ordering_.forcedReleases());
+  stat.add("pickers added / removed / requests refused",
+           std::to_string(added_) + " / " + std::to_string(removed_) + " / " + std::to_string(refused_requests_));
+  stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "tracking %zu picker(s)", tracks_.size());
+}
+
+void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const auto& c = t.filter->counters();
+  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old;
+  stat.hardware_id = t.id;
+  stat.add("picker_id", t.id);
+  stat.add("observations received", t.received);
+  stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("accepted", c.accepted);
   stat.add("reordered (late, within window)", c.reordered);
   stat.add("dropped (too old)", c.dropped_too_old);
   stat.add("rejected (invalid)", c.rejected_invalid);
   stat.add("ignored (sensor not fused in this mode)", c.ignored_sensor);
-  stat.add("ignored (another picker's)", other_picker_);
-  stat.add("unknown node names skipped", unknown_nodes_);
+  stat.add("unknown node names skipped", t.unknown_nodes);
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);
   stat.add("predictions", c.predictions);
-  stat.add("what-if calls", what_if_calls_);
-  stat.add("resets", resets_);
-  const auto& b = filter_->belief();
+  stat.add("what-if calls", t.what_if_calls);
+  stat.add("resets", t.resets);
+  const auto& b = t.filter->belief();
   stat.add("entropy (nats)", b.entropy);
   stat.add("jsd", b.jsd);
   stat.add("p_rj", b.unconnected_jump_probability);
   if (b.initialised && b.map_node < map_->numNodes()) stat.add("estimated node", map_->node(b.map_node).name);
-  if (problems > last_reported_problems_) {
-    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, last_problem_);
+  if (problems > t.last_reported_problems) {
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, t.last_problem);
   } else if (!b.initialised) {
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "waiting for the first observation");
   } else {
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   }
-  last_reported_problems_ = problems;
+  t.last_reported_problems = problems;
 }
 
 }  // namespace ros_adapter

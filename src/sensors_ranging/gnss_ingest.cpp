@@ -44,7 +44,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "map_file",
         "map_timeout",      "frame_id",     "observation_topic", "topological_map", "max_future_stamp",
-        "person_observation_topic", "belief_topic_prefix", "bias_topic_prefix", "ordering_latency"};
+        "person_observation_topic", "belief_topic_prefix", "bias_topic_prefix", "ordering_latency", "registry_topic"};
     known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
     known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
                  PickerAssociationOptions::yamlKeys().end());

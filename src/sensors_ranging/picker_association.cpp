@@ -48,8 +48,16 @@ BeliefView BeliefHistory::atOrBefore(double t) const {
 
 std::vector<BeliefView> beliefViews(const std::vector<BeliefHistory>& histories, double stamp,
                                     const PickerAssociationOptions& options) {
+  std::vector<const BeliefHistory*> pointers;
+  for (const BeliefHistory& h : histories) pointers.push_back(&h);
+  return beliefViews(pointers, stamp, options);
+}
+
+std::vector<BeliefView> beliefViews(const std::vector<const BeliefHistory*>& histories, double stamp,
+                                    const PickerAssociationOptions& options) {
   std::vector<BeliefView> views;
-  for (const BeliefHistory& h : histories) views.push_back(h.atOrBefore(stamp - options.belief_lag));
+  views.reserve(histories.size());
+  for (const BeliefHistory* h : histories) views.push_back(h->atOrBefore(stamp - options.belief_lag));
   return views;
 }
 

@@ -13,7 +13,12 @@ struct PickerConfig {
   std::string gnss_topic;              // sensor_msgs/NavSatFix topic of the picker's phone / IoT unit ("" none)
   std::vector<std::string> rfid_tags;  // RFID tag ids worn by the picker
   std::string uwb_tag;                 // UWB tag id worn by the picker ("" none)
+  std::string tpf_overrides;           // YAML mapping of config/tpf.yaml keys for this picker's filter ("" none)
 };
+
+// "" when `id` can name a picker (it becomes a ROS name component: /pickers/<id>/belief, a tf frame):
+// a letter first, then letters, digits and '_'; else why not.
+std::string pickerIdProblem(const std::string& id);
 
 // Format:
 //   pickers:
@@ -21,8 +26,9 @@ struct PickerConfig {
 //       gnss_topic: /pickers/picker_1/fix
 //       rfid_tags: [tag_0001]
 //       uwb_tag: uwb_0001
+//       tpf: {num_particles: 2000}   # optional overrides of config/tpf.yaml for this picker
 // Throws std::runtime_error with one line naming the file, the entry and the field on a bad file
-// (missing or duplicate id, a tag claimed by two pickers, wrong types).
+// (missing, invalid or duplicate id, an empty tag or one claimed by two pickers, wrong types).
 class PickerRegistry {
  public:
   static PickerRegistry load(const std::string& path);
@@ -36,6 +42,12 @@ class PickerRegistry {
   std::optional<std::string> pickerForRfidTag(const std::string& tag) const;
   std::optional<std::string> pickerForUwbTag(const std::string& tag) const;
   std::vector<std::string> ids() const;
+
+  // Run-time changes (tpf_tracker's add / remove services). add() throws std::runtime_error, changing nothing,
+  // when the picker could not be in a registry with the others (the rules above); remove() is false for an
+  // unknown id.
+  void add(PickerConfig picker);
+  bool remove(const std::string& id);
 
  private:
   std::vector<PickerConfig> pickers_;

@@ -7,6 +7,7 @@
 #include <picker_localisation/BearingDetectionArray.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerList.h>
 #include <picker_localisation/RfidReading.h>
 #include <picker_localisation/UwbRange.h>
 #include <ros/ros.h>
@@ -18,6 +19,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "picker_localisation/core/picker_registry.h"
@@ -47,13 +49,17 @@ std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string
 // Planar part of a 3D transform: x, y and the yaw of the x axis.
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 
-// gnss_ingest: one NavSatFix subscription per picker (config/pickers.yaml gnss_topic).
+// gnss_ingest: one NavSatFix subscription per picker (config/pickers.yaml gnss_topic). It follows the
+// tracker's picker list (~registry_topic, latched PickerList, default /pickers/registry): a picker added to or
+// removed from tpf_tracker at run time gets its fixes ingested or dropped; before a list arrives (or with
+// ~registry_topic "") the ~pickers_file is the list.
 // It also gives identity to anonymous people: Observations from every robot's leg_detector on
 // ~person_observation_topic are associated with the pickers (sensors::associatePerson, against each picker's
 // bias-corrected fix and its tracker's belief from /pickers/<id>/belief); a clear association is published as
 // an identifying observation of that picker and is a sighting for its GNSS bias estimate, an ambiguous one is
-// published unchanged. Fixes and people are processed in stamp order (~ordering_latency), beliefs chosen by
-// stamp (association_belief_lag), so a replayed bag gives the same output twice. Publishes the bias per picker
+// published unchanged. With ~ordering_latency > 0 (automatic: 0.2 s under /use_sim_time) fixes and people are
+// processed in stamp order, beliefs chosen by stamp (association_belief_lag), so a replayed bag gives the same
+// output twice; live (0) each message is processed on arrival. Publishes the bias per picker
 // (/pickers/<id>/gnss_bias, GnssBias) and rviz markers (~bias_markers: raw fix -> corrected fix).
 class GnssIngestNode {
  public:
@@ -61,40 +67,56 @@ class GnssIngestNode {
   bool ok() const { return ok_; }
 
  private:
+  // One picker with a GNSS device: its ingest (fix checks, bias estimate), its tracker's recent beliefs, its
+  // subscriptions and bias topic.
+  struct Picker {
+    Picker(const core::PickerConfig& config, std::shared_ptr<const topology::TopologicalMap> map,
+           const sensors::GeodeticDatum& datum, const sensors::GnssIngestOptions& options)
+        : config(config), ingest(config.id, std::move(map), datum, options) {}
+    core::PickerConfig config;
+    sensors::GnssIngest ingest;
+    sensors::BeliefHistory beliefs;
+    ros::Subscriber fix_sub, belief_sub;
+    ros::Publisher bias_pub;
+  };
   struct Input {
     bool is_fix = true;
     bool is_sighting = false;  // an identifying RFID / UWB observation (bias_sighting_sensors)
-    std::size_t picker = 0;
+    std::string picker;        // the fix's picker (looked up on release: it may have been removed meanwhile)
     sensors::GnssFix fix;
     core::Observation person;
   };
-  void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, std::size_t picker);
+  void addPicker(const core::PickerConfig& p);
+  void onRegistry(const picker_localisation::PickerList::ConstPtr& msg);
+  void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
-  void onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, std::size_t picker);
   void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
+  void onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, Picker* picker);
   bool checkClock();
   std::vector<sensors::GnssIngest*> pickerPointers();
+  std::vector<const sensors::BeliefHistory*> beliefHistories() const;
   void releaseOrdered();
-  void processFix(std::size_t picker, const sensors::GnssFix& fix);
+  void processFix(Picker& picker, const sensors::GnssFix& fix);
   void processPerson(const core::Observation& person);
-  void publishBias(std::size_t picker, double stamp, const sensors::GnssResult& r);
+  void publishBias(Picker& picker, double stamp, const sensors::GnssResult& r);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
   bool ok_ = false;
+  ros::NodeHandle nh_;
   std::shared_ptr<const topology::TopologicalMap> map_;
-  std::string frame_id_;
+  std::unique_ptr<sensors::GeodeticDatum> datum_;
+  std::string frame_id_, belief_prefix_, bias_prefix_;
   sensors::GnssIngestOptions options_;
-  std::vector<sensors::GnssIngest> ingest_;
-  std::vector<sensors::BeliefHistory> beliefs_;
+  std::vector<std::unique_ptr<Picker>> pickers_;  // in the order of the list
+  std::unordered_map<std::string, Picker*> by_id_;
   std::vector<ros::Subscriber> subs_;
   ros::Publisher pub_, markers_pub_;
-  std::vector<ros::Publisher> bias_pubs_;
   core::StampOrderedBuffer<Input> ordering_;
-  double ordering_latency_ = 0.2;
+  double ordering_latency_ = 0.0;
   ros::Timer ordering_timer_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
-  std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0;
+  std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   StampGuard stamp_guard_;
 };
 

@@ -14,6 +14,14 @@ inline double secondsBetween(const ros::Time& from, const ros::Time& to) {
   return to.toSec() - from.toSec();
 }
 
+// A node's ~ordering_latency: a value >= 0 as given; a negative one (the default, "automatic") is
+// `replay_latency` under /use_sim_time (bags, simulator: messages wait and are processed in stamp order, so a
+// replay is deterministic) and 0 live (each message processed on arrival: milliseconds of latency).
+inline double orderingLatency(double param, double replay_latency) {
+  if (param >= 0.0) return param;
+  return ros::Time::isSimTime() ? replay_latency : 0.0;
+}
+
 class StampGuard {
  public:
   explicit StampGuard(double max_future = 10.0, double jump_tolerance = 1.0)

@@ -1,22 +1,32 @@
-// tpf_tracker: the Topological Particle Filter of one picker (Navigate-and-Seek Sec. IV) as a ROS node.
+// tpf_tracker: the Topological Particle Filters of a whole farm's pickers in one node, one TPF per picker
+// (Navigate-and-Seek Sec. IV; issue "Track a whole farm in one process").
 //
-// Subscribes ~observations_topic (default /observations, picker_localisation/Observation): identifying
-// observations only when their picker_id is this tracker's ~picker_id, non-identifying ones always.
-// Publishes <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
+// Pickers: ~pickers_file (config/pickers.yaml: every entry, each with its optional `tpf:` overrides) or one
+// ~picker_id; more are added and removed at run time with the services ~add_picker (AddPicker),
+// ~remove_picker (RemovePicker) and ~list_pickers (ListPickers). A bad request (invalid, empty or duplicate
+// id, an empty tag or one another picker wears, a bad GNSS topic name, bad overrides) is refused with a
+// message and changes nothing. Started from a pickers file, the current list is latched on <prefix>/registry
+// (PickerList), which gnss_ingest follows (not with one ~picker_id, which names no GNSS topic).
+// Per picker: <prefix>/<id>/belief (PickerBelief, latched), <prefix>/<id>/estimate
 // (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
-// belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node
-// highlighted); prefix ~topic_prefix = /pickers. Services <prefix>/<id>/reset (ResetBelief) and
-// <prefix>/<id>/what_if (WhatIf, on a copy of the filter). Periodic prediction at prediction_rate Hz of ROS
-// time (ros::Timer: sim time and bags work) when no observation arrived for a period. Diagnostics: counts of
-// accepted / reordered / dropped / rejected / other-picker observations, re-initialisations, health.
-// Deterministic order (replay): observations wait ~ordering_latency seconds of ROS time (default 0.5; 0
-// processes each on arrival) in a StampOrderedBuffer and are fused in stamp order, whichever publisher's
-// message arrived first; periodic predictions fall on lastStamp + k / prediction_rate (never on the time a
-// timer happened to fire) and are also made, in order, before an observation that comes later than that. So a
-// bag replayed twice gives the same beliefs, provided messages arrive within the latency.
-// Parameters (private): picker_id (required), map_file (else the latched topological_map topic),
+// belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node highlighted;
+// built only while someone subscribes, the current one sent on connect); services <prefix>/<id>/reset
+// (ResetBelief) and <prefix>/<id>/what_if (WhatIf, on a copy of the filter); prefix ~topic_prefix = /pickers.
+// Routing: one subscription to ~observations_topic (/observations); each message is decoded once and goes to
+// the one filter it identifies, to its candidate pickers, or (anonymous, no candidates) to every filter
+// (core::concernsPicker's rule, by lookup).
+// Time: periodic prediction at each picker's prediction_rate (ROS time, one timer for all pickers) when no
+// observation arrived for a period, on lastStamp + k / prediction_rate (never on the time a timer fired).
+// ~ordering_latency: observations wait that many seconds of ROS time and are fused in stamp order, whichever
+// publisher's message arrived first, so a bag replayed twice gives the same beliefs. Default -1 = automatic:
+// 0.5 s under /use_sim_time (bags, simulator: deterministic replay), 0 live (each observation fused on
+// arrival, within milliseconds; one that arrives late, within reorder_window, is fused at the filter's
+// current time, as the filter documents). Clock jumps back reset every belief.
+// Diagnostics: one status for the fleet and one per picker.
+// Parameters (private): pickers_file or picker_id, map_file (else the latched topological_map topic),
 // tpf_params_file (YAML like config/tpf.yaml) overridden key by key by private parameters with the same
-// names (e.g. ~num_particles, ~method), seed (0: derived from picker_id), frame_id (map).
+// names (e.g. ~num_particles, ~method) and then by a picker's own overrides, seed (0: derived from each
+// picker's id), frame_id (map), max_future_stamp (10 s).
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
@@ -27,21 +37,25 @@
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/ResetBelief.h>
 #include <picker_localisation/WhatIf.h>
+#include <picker_localisation/AddPicker.h>
+#include <picker_localisation/ListPickers.h>
+#include <picker_localisation/RemovePicker.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <yaml-cpp/yaml.h>
+
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
-
-// TPF parameters from a private namespace: ~tpf_params_file (when set) as the base, then every private
-// parameter named like a key of config/tpf.yaml on top. Throws std::runtime_error naming the key.
-tpf::TpfParams tpfParamsFromRos(const ros::NodeHandle& pnh);
 
 // Stable 64-bit seed from a picker id (FNV-1a), never 0.
 std::uint64_t seedFromId(const std::string& id);
@@ -55,44 +69,72 @@ geometry_msgs::PoseWithCovarianceStamped toEstimateMsg(const tpf::Belief& belief
 visualization_msgs::MarkerArray toMarkers(const tpf::Belief& belief, const topology::TopologicalMap& map,
                                           const std::string& picker_id, const std::string& frame_id);
 
+// The merged TPF parameters YAML of a private namespace: ~tpf_params_file (when set) as the base, then every
+// private parameter on top. Throws std::runtime_error naming the file on a YAML error.
+YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh);
+// `base` with a picker's overrides (YAML mapping text, "" none) on top. Throws std::runtime_error naming the
+// key on a bad value.
+tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides);
+
 class TpfTracker {
  public:
   TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh);
-  bool ok() const { return filter_ != nullptr; }
+  ~TpfTracker();
+  bool ok() const { return ok_; }
+  std::size_t size() const { return tracks_.size(); }
 
  private:
+  struct Track;  // one picker: filter, topics, services, counters
+  struct Pending {
+    core::Observation obs;
+    std::string sensor;
+  };
+  // Starts tracking a picker (already in registry_); false and *error when its parameters are bad.
+  bool startTrack(const core::PickerConfig& picker, std::string* error);
+  // The tracks an observation concerns.
+  std::vector<Track*> route(bool identifying, const std::string& picker_id, const std::vector<std::string>& candidates);
   void observationCallback(const picker_localisation::Observation::ConstPtr& msg);
-  void timerCallback(const ros::TimerEvent&);
-  void orderingCallback(const ros::TimerEvent&);
+  void dispatch(const Pending& p);
+  void predictionTick(const ros::TimerEvent&);
+  void orderingTick(const ros::TimerEvent&);
   // Fuses one observation after the periodic predictions that fall due before its stamp.
-  void process(const core::Observation& obs, const std::string& sensor);
+  void process(Track& t, const core::Observation& obs, const std::string& sensor);
   // Periodic predictions at lastStamp + k * period up to `until` (s).
-  void predictDueUntil(double until);
-  bool reset(picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res);
-  bool whatIf(picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res);
-  void publish();
+  void predictDueUntil(Track& t, double until);
+  void publish(Track& t);
+  void publishRegistry();
+  void updatePredictionTimer();
+  bool addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res);
+  bool removePicker(picker_localisation::RemovePicker::Request& req,
+                    picker_localisation::RemovePicker::Response& res);
+  bool listPickers(picker_localisation::ListPickers::Request& req, picker_localisation::ListPickers::Response& res);
   static constexpr int kMaxPredictionsPerCall = 100;  // a longer silence is bridged by one prediction
-  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
-
-  std::string picker_id_, frame_id_;
-  std::shared_ptr<const topology::TopologicalMap> map_;
-  std::unique_ptr<tpf::TopologicalParticleFilter> filter_;
-  ros::Subscriber sub_;
-  ros::Publisher belief_pub_, estimate_pub_, markers_pub_;
-  ros::ServiceServer reset_srv_, what_if_srv_;
-  ros::Timer timer_, diagnostics_timer_, ordering_timer_;
-  core::StampOrderedBuffer<std::pair<core::Observation, std::string>> ordering_;
-  double ordering_latency_ = 0.5;
-  diagnostic_updater::Updater diagnostics_;
-  double prediction_period_ = 0.0;
-  std::uint64_t received_ = 0, other_picker_ = 0, unknown_nodes_ = 0, what_if_calls_ = 0, resets_ = 0;
-  StampGuard stamp_guard_;
-  // The clock jumped back (bag loop, simulator restart): the belief and the waiting observations are dropped
-  // so the next observation initialises the filter again (its stamps would all be "too old" otherwise).
+  void diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  void diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat);
+  // The clock jumped back (bag loop, simulator restart): every belief and the waiting observations are dropped
+  // so the next observation initialises each filter again (its stamps would all be "too old" otherwise).
   void checkClockJump();
-  std::uint64_t last_reported_problems_ = 0, last_diag_received_ = 0;
+
+  bool ok_ = false;
+  ros::NodeHandle nh_;
+  std::string frame_id_, prefix_;
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  YAML::Node base_params_;
+  int seed_param_ = 0;
+  core::PickerRegistry registry_;
+  std::map<std::string, std::unique_ptr<Track>> tracks_;
+  ros::Subscriber sub_;
+  ros::Publisher registry_pub_;
+  ros::ServiceServer add_srv_, remove_srv_, list_srv_;
+  ros::Timer prediction_timer_, diagnostics_timer_, ordering_timer_;
+  double timer_period_ = 0.0;
+  core::StampOrderedBuffer<Pending> ordering_;
+  double ordering_latency_ = 0.0;
+  diagnostic_updater::Updater diagnostics_;
+  std::uint64_t received_ = 0, unrouted_ = 0, added_ = 0, removed_ = 0, refused_requests_ = 0;
+  StampGuard stamp_guard_;
+  std::uint64_t last_diag_received_ = 0;
   ros::WallTime last_diag_time_;
-  std::string last_problem_;
 };
 
 }  // namespace ros_adapter

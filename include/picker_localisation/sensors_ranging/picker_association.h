@@ -62,6 +62,8 @@ class BeliefHistory {
 // One view per picker: the belief association_belief_lag before `stamp`.
 std::vector<BeliefView> beliefViews(const std::vector<BeliefHistory>& histories, double stamp,
                                     const PickerAssociationOptions& options);
+std::vector<BeliefView> beliefViews(const std::vector<const BeliefHistory*>& histories, double stamp,
+                                    const PickerAssociationOptions& options);
 
 struct AssociationResult {
   core::Observation observation;      // the detection: identifying (picker_id set) or unchanged (anonymous)
