@@ -18,6 +18,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
+#include <set>
 #include <map>
 #include <memory>
 
@@ -54,6 +55,12 @@ class TrackerTest : public ::testing::Test {
             topics_[id].markers.push_back(*m);
           }));
       ASSERT_TRUE(ros::service::waitForService("/pickers/" + id + "/what_if", ros::Duration(60.0))) << id;
+    }
+    // Per-picker topics come on demand (on_demand_topics_above 2): these subscriptions bring them up.
+    for (const auto& sub : subs_) {
+      const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
+      while (sub.getNumPublishers() == 0 && ros::WallTime::now() < deadline) ros::WallDuration(0.05).sleep();
+      ASSERT_GT(sub.getNumPublishers(), 0u) << sub.getTopic() << " was not advertised for its subscriber";
     }
     // One node tracks every picker: one subscription to /observations.
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
@@ -326,6 +333,14 @@ TEST_F(TrackerTest, PickersAddedAndRemovedAtRunTime) {
   if (!topics_["picker_1"].beliefs.empty()) {
     EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, p1);
   }
+  // On demand: nobody subscribes to picker_4's estimate, so it is not advertised; its belief (subscribed) is.
+  ros::master::V_TopicInfo advertised;
+  ASSERT_TRUE(ros::master::getTopics(advertised));
+  std::set<std::string> names;
+  for (const auto& t : advertised) names.insert(t.name);
+  EXPECT_TRUE(names.count("/pickers/picker_4/belief"));
+  EXPECT_FALSE(names.count("/pickers/picker_4/estimate"));
+  EXPECT_TRUE(names.count("/pickers/beliefs"));  // the fleet stream always
 
   // Removal: unknown ids refused; the picker's services go, the others stay.
   picker_localisation::RemovePicker unknown;

@@ -9,6 +9,7 @@
 
 #include <picker_localisation/GnssBias.h>
 
+#include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
@@ -46,14 +47,23 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   std::string topic, person_topic, registry_topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
-  pnh.param<std::string>("belief_topic_prefix", belief_prefix_, "/pickers");
+  std::string belief_topic;
+  pnh.param<std::string>("belief_topic", belief_topic, "/pickers/beliefs");
   pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
   pnh.param<std::string>("registry_topic", registry_topic, "/pickers/registry");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
+  on_demand_topics_above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
+  demand_period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
+  if (registry.size() > on_demand_topics_above_) demand_ = std::make_unique<TopicDemand>(demand_period_);
   ordering_ = core::StampOrderedBuffer<Input>(ordering_latency_, 10000 + 20 * registry.size());
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 1000);
-  markers_pub_ = pnh.advertise<visualization_msgs::MarkerArray>("bias_markers", 2, true);
+  markers_pub_ = CountedPublisher::advertise<visualization_msgs::MarkerArray>(pnh, "bias_markers", 2, {}, true);
   for (const core::PickerConfig& p : registry.pickers()) addPicker(p);
+  if (o.association.enabled && o.association.belief_weight > 0.0 && !belief_topic.empty())
+    subs_.push_back(nh.subscribe<picker_localisation::PickerBeliefArray>(
+        belief_topic, 100, [this](const picker_localisation::PickerBeliefArray::ConstPtr& m) {
+          for (const auto& b : m->beliefs) onBelief(b);
+        }));
   if (!registry_topic.empty())
     subs_.push_back(nh.subscribe<picker_localisation::PickerList>(
         registry_topic, 2, [this](const picker_localisation::PickerList::ConstPtr& m) { onRegistry(m); }));
@@ -72,6 +82,8 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   if (pickers_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
   ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
+  demand_timer_ = nh.createWallTimer(ros::WallDuration(std::max(0.1, demand_period_ / 2.0)),
+                                     [this](const ros::WallTimerEvent&) { demandSweep(); });
   updater_.setHardwareID("gnss_ingest");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
@@ -86,12 +98,23 @@ void GnssIngestNode::addPicker(const core::PickerConfig& p) {
   raw->fix_sub = nh_.subscribe<sensor_msgs::NavSatFix>(
       p.gnss_topic, 50, [this, raw](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, raw); },
       ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  raw->bias_pub = nh_.advertise<picker_localisation::GnssBias>(bias_prefix_ + "/" + p.id + "/gnss_bias", 5, true);
-  if (options_.association.enabled && options_.association.belief_weight > 0.0)
-    raw->belief_sub = nh_.subscribe<picker_localisation::PickerBelief>(
-        belief_prefix_ + "/" + p.id + "/belief", 20,
-        [this, raw](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(m, raw); });
+  raw->bias_topic = nh_.resolveName(bias_prefix_ + "/" + p.id + "/gnss_bias");
+  advertiseBias(*raw);
   ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
+}
+
+void GnssIngestNode::advertiseBias(Picker& p) {
+  // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
+  const TopicDemand* demand = pickers_.size() > on_demand_topics_above_ ? demand_.get() : nullptr;
+  advertiseWhileWanted(p.bias_pub, p.bias_topic, demand, [&] { p.bias_pub.advertise(nh_, p.bias_topic, 5); });
+}
+
+void GnssIngestNode::demandSweep() {
+  if (pickers_.size() > on_demand_topics_above_ && !demand_) demand_ = std::make_unique<TopicDemand>(demand_period_);
+  const std::uint64_t polls = demand_ ? demand_->polls() : 0;
+  if (polls == last_demand_poll_ && (polls > 0 || demand_)) return;
+  last_demand_poll_ = polls;
+  for (auto& p : pickers_) advertiseBias(*p);
 }
 
 void GnssIngestNode::onRegistry(const picker_localisation::PickerList::ConstPtr& msg) {
@@ -229,7 +252,10 @@ void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstP
   ordering_.push(in.person.stamp, "sighting|" + msg->sensor + "|" + msg->picker_id + "|" + msg->robot_id, std::move(in));
 }
 
-void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, Picker* picker) {
+void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& belief) {
+  const picker_localisation::PickerBelief* msg = &belief;
+  const auto it = by_id_.find(msg->picker_id);
+  if (it == by_id_.end()) return;  // a picker without GNSS here
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
   for (std::size_t k = 0; k < msg->nodes.size() && k < msg->masses.size(); ++k) {
@@ -238,7 +264,7 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief::ConstPtr&
     nodes.push_back(*n);
     masses.push_back(msg->masses[k]);
   }
-  picker->beliefs.push(msg->header.stamp.toSec(), nodes, masses);
+  it->second->beliefs.push(msg->header.stamp.toSec(), nodes, masses);
 }
 
 void GnssIngestNode::releaseOrdered() {
@@ -308,7 +334,7 @@ void GnssIngestNode::publishBias(Picker& picker, double stamp, const sensors::Gn
   m.refused = static_cast<std::uint32_t>(b.refused());
   picker.bias_pub.publish(m);
 
-  if (markers_pub_.getNumSubscribers() == 0) return;
+  if (!markers_pub_.hasSubscribers()) return;
   visualization_msgs::MarkerArray markers;
   visualization_msgs::Marker arrow;
   arrow.header = m.header;

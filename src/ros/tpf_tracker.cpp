@@ -1,12 +1,15 @@
 #include "picker_localisation/ros/tpf_tracker.h"
 
 #include <picker_localisation/PickerList.h>
+#include <boost/make_shared.hpp>
+#include <ros/callback_queue.h>
 #include <ros/names.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/observation_conversions.h"
@@ -189,10 +192,13 @@ struct TpfTracker::Track {
   std::string id;
   std::unique_ptr<tpf::TopologicalParticleFilter> filter;
   double prediction_period = 0.0;  // s; 0: no periodic prediction
-  ros::Publisher belief_pub, estimate_pub, markers_pub;
+  LastValuePublisher<picker_localisation::PickerBelief> belief_pub;
+  LastValuePublisher<geometry_msgs::PoseWithCovarianceStamped> estimate_pub;
+  CountedPublisher markers_pub;
   ros::ServiceServer reset_srv, what_if_srv;
   std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0;
   std::string last_problem;
+  std::string belief_topic, estimate_topic, markers_topic;  // resolved names
 };
 
 TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
@@ -214,6 +220,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     // The pickers file's and picker_id's keys are this node's, not the filter's.
     for (const char* own : {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id",
                             "topic_prefix", "observations_topic", "ordering_latency", "max_future_stamp",
+                            "on_demand_topics_above", "demand_poll_period",
                             "map_timeout", "map_topic"})
       base_params_.remove(own);
     tpf::TpfParams::fromYaml(base_params_);  // a bad shared value is one FATAL line, not one per picker
@@ -231,6 +238,9 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   pnh.param<std::string>("observations_topic", observations_topic, "/observations");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.5);
   stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
+  on_demand_topics_above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
+  demand_period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
+  if (registry_.size() > on_demand_topics_above_) demand_ = std::make_unique<TopicDemand>(demand_period_);
   ordering_ = core::StampOrderedBuffer<Pending>(ordering_latency_, 10000 + 20 * registry_.size());
 
   const std::vector<core::PickerConfig> initial = registry_.pickers();
@@ -247,6 +257,9 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     registry_pub_ = nh.advertise<picker_localisation::PickerList>(prefix_ + "/registry", 1, true);
     publishRegistry();
   }
+  // The fleet stream: every flush's beliefs in one message, so a consumer of every picker costs one connection
+  // and, under load, one message per burst.
+  fleet_pub_ = CountedPublisher::advertise<picker_localisation::PickerBeliefArray>(nh, prefix_ + "/beliefs", 100);
   add_srv_ = pnh.advertiseService("add_picker", &TpfTracker::addPicker, this);
   remove_srv_ = pnh.advertiseService("remove_picker", &TpfTracker::removePicker, this);
   list_srv_ = pnh.advertiseService("list_pickers", &TpfTracker::listPickers, this);
@@ -256,6 +269,9 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
                                      &TpfTracker::orderingTick, this);
   updatePredictionTimer();
+  // Per-picker topics on demand above ~on_demand_topics_above pickers (see advertiseTopics).
+  demand_timer_ = nh.createWallTimer(ros::WallDuration(std::max(0.1, demand_period_ / 2.0)),
+                                     [this](const ros::WallTimerEvent&) { demandSweep(); });
   diagnostics_.setHardwareID("tpf_tracker");
   diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
   diagnostics_timer_ =
@@ -266,7 +282,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   ok_ = true;
 }
 
-TpfTracker::~TpfTracker() = default;
+TpfTracker::~TpfTracker() { ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<std::uint64_t>(this)); }
 
 bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error) {
   tpf::TpfParams params;
@@ -283,13 +299,10 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
   t->filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
   t->prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 0.0;
   const std::string base = prefix_ + "/" + picker.id;
-  t->belief_pub = nh_.advertise<picker_localisation::PickerBelief>(base + "/belief", 10, true);
-  t->estimate_pub = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>(base + "/estimate", 10, true);
-  // Markers are built only for a subscriber (rviz); a new one gets the current markers at once.
-  t->markers_pub = nh_.advertise<visualization_msgs::MarkerArray>(
-      base + "/markers", 2, [this, raw](const ros::SingleSubscriberPublisher& s) {
-        s.publish(toMarkers(raw->filter->belief(), *map_, raw->id, frame_id_));
-      });
+  t->belief_topic = nh_.resolveName(base + "/belief");
+  t->estimate_topic = nh_.resolveName(base + "/estimate");
+  t->markers_topic = nh_.resolveName(base + "/markers");
+  advertiseTopics(*t);
   t->reset_srv = nh_.advertiseService<picker_localisation::ResetBelief::Request, picker_localisation::ResetBelief::Response>(
       base + "/reset", [this, raw](picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res) {
         raw->filter->reset();
@@ -297,6 +310,7 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
         res.success = true;
         res.message = "belief of " + raw->id + " forgotten; the next observation initialises it";
         publish(*raw);
+        flush();
         return true;
       });
   t->what_if_srv = nh_.advertiseService<picker_localisation::WhatIf::Request, picker_localisation::WhatIf::Response>(
@@ -335,9 +349,35 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
                    [this, raw](diagnostic_updater::DiagnosticStatusWrapper& stat) { diagnose(*raw, stat); });
   tracks_[picker.id] = std::move(t);
   publish(*raw);  // "waiting for the first observation": the topic exists from the start
+  flush();
   ROS_INFO("tpf_tracker %s: %zu particles, method %s motion, prediction every %.1f s", picker.id.c_str(),
            params.num_particles, tpf::toString(params.motion_model), raw->prediction_period);
   return true;
+}
+
+void TpfTracker::advertiseTopics(Track& t) {
+  // Few pickers: every topic always. A farm's worth: each while someone subscribes (the master polled).
+  const TopicDemand* demand = tracks_.size() > on_demand_topics_above_ ? demand_.get() : nullptr;
+  Track* raw = &t;
+  advertiseWhileWanted(t.belief_pub, t.belief_topic, demand, [&] { t.belief_pub.advertise(nh_, t.belief_topic, 10); });
+  advertiseWhileWanted(t.estimate_pub, t.estimate_topic, demand,
+                       [&] { t.estimate_pub.advertise(nh_, t.estimate_topic, 10); });
+  // Markers are built only for a subscriber (rviz); a new one gets the current markers at once.
+  advertiseWhileWanted(t.markers_pub, t.markers_topic, demand, [&] {
+    t.markers_pub = CountedPublisher::advertise<visualization_msgs::MarkerArray>(
+        nh_, t.markers_topic, 2, [this, raw](const ros::SingleSubscriberPublisher& s) {
+          s.publish(toMarkers(raw->filter->belief(), *map_, raw->id, frame_id_));
+        });
+  });
+}
+
+void TpfTracker::demandSweep() {
+  if (tracks_.size() > on_demand_topics_above_ && !demand_) demand_ = std::make_unique<TopicDemand>(demand_period_);
+  const std::uint64_t polls = demand_ ? demand_->polls() : 0;
+  if (polls == last_demand_poll_ && (polls > 0 || demand_)) return;  // nothing new from the master
+  last_demand_poll_ = polls;
+  flush();
+  for (auto& kv : tracks_) advertiseTopics(*kv.second);
 }
 
 void TpfTracker::updatePredictionTimer() {
@@ -394,6 +434,7 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
                       msg->sensor.c_str());
   if (ordering_latency_ <= 0.0) {
     for (Track* t : targets) process(*t, p.obs, p.sensor);
+    flushWhenIdle();
     return;
   }
   // Tie-break equal stamps by content so the fusion order never depends on arrival order.
@@ -418,6 +459,7 @@ void TpfTracker::checkClockJump() {
     ++kv.second->resets;
     publish(*kv.second);
   }
+  flush();
 }
 
 void TpfTracker::orderingTick(const ros::TimerEvent&) {
@@ -425,6 +467,7 @@ void TpfTracker::orderingTick(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   if (now <= 0.0) return;
   for (auto& item : ordering_.release(now)) dispatch(item.second);
+  flush();
 }
 
 void TpfTracker::predictDueUntil(Track& t, double until) {
@@ -438,6 +481,7 @@ void TpfTracker::predictDueUntil(Track& t, double until) {
     publish(t);
   }
 }
+
 
 void TpfTracker::process(Track& t, const core::Observation& obs, const std::string& sensor) {
   if (std::isfinite(obs.stamp)) predictDueUntil(t, obs.stamp);
@@ -460,13 +504,65 @@ void TpfTracker::predictionTick(const ros::TimerEvent&) {
   if (now <= 0.0) return;  // sim clock not running yet
   // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
   for (auto& kv : tracks_) predictDueUntil(*kv.second, now - ordering_latency_);
+  flush();
 }
 
 void TpfTracker::publish(Track& t) {
+  // Queued, sent by flush(): messages published back to back cost roscpp's poll thread one walk over every
+  // publication of the process, not one walk each.
   const tpf::Belief& b = t.filter->belief();
-  t.belief_pub.publish(toBeliefMsg(b, *map_, t.id, frame_id_));
-  if (b.initialised) t.estimate_pub.publish(toEstimateMsg(b, *map_, frame_id_));
-  if (t.markers_pub.getNumSubscribers() > 0) t.markers_pub.publish(toMarkers(b, *map_, t.id, frame_id_));
+  Outgoing out{&t, toBeliefMsg(b, *map_, t.id, frame_id_), std::nullopt, std::nullopt};
+  if (b.initialised) out.estimate = toEstimateMsg(b, *map_, frame_id_);
+  if (t.markers_pub.hasSubscribers()) out.markers = toMarkers(b, *map_, t.id, frame_id_);
+  outgoing_.push_back(std::move(out));
+}
+
+void TpfTracker::flush() {
+  if (outgoing_.empty()) return;
+  picker_localisation::PickerBeliefArray fleet;
+  const bool to_fleet = fleet_pub_.hasSubscribers();
+  for (Outgoing& o : outgoing_) {
+    if (to_fleet) fleet.beliefs.push_back(o.belief);
+    o.track->belief_pub.publish(std::move(o.belief));
+    if (o.estimate) o.track->estimate_pub.publish(std::move(*o.estimate));
+    if (o.markers) o.track->markers_pub.publish(*o.markers);
+  }
+  outgoing_.clear();
+  if (to_fleet) {
+    fleet.header.stamp = fleet.beliefs.back().header.stamp;
+    fleet_pub_.publish(fleet);
+  }
+}
+
+namespace {
+// Runs TpfTracker::flush() once the callbacks queued before it have run.
+class FlushCallback : public ros::CallbackInterface {
+ public:
+  explicit FlushCallback(std::function<void()> f) : f_(std::move(f)) {}
+  CallResult call() override {
+    f_();
+    return Success;
+  }
+
+ private:
+  std::function<void()> f_;
+};
+}  // namespace
+
+void TpfTracker::flushWhenIdle() {
+  // The beliefs go out once the messages already waiting in the callback queue are fused (no added latency
+  // when none waits; one burst under load), or at once after 64.
+  if (outgoing_.empty()) return;
+  if (outgoing_.size() >= 64) {
+    flush();
+    return;
+  }
+  if (flush_scheduled_) return;
+  flush_scheduled_ = true;
+  ros::getGlobalCallbackQueue()->addCallback(boost::make_shared<FlushCallback>([this] {
+    flush_scheduled_ = false;
+    flush();
+  }), reinterpret_cast<std::uint64_t>(this));
 }
 
 namespace {
@@ -540,6 +636,7 @@ bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
     res.message = "no picker '" + req.id + "' is tracked (list_pickers names them)";
     return true;
   }
+  flush();  // nothing queued may outlive its track
   // rviz keeps the last markers of a topic that goes away: delete them first.
   visualization_msgs::MarkerArray gone = toMarkers(tpf::Belief{}, *map_, req.id, frame_id_);
   for (auto& m : gone.markers) m.action = visualization_msgs::Marker::DELETE;
@@ -569,6 +666,12 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
   last_diag_time_ = now;
   last_diag_received_ = received_;
   stat.add("pickers", tracks_.size());
+  std::size_t advertised = 0;
+  for (const auto& kv : tracks_)
+    advertised += kv.second->belief_pub.advertised() + kv.second->estimate_pub.advertised() +
+                  kv.second->markers_pub.advertised();
+  stat.add("per-picker topics advertised", advertised);
+  stat.add("per-picker topics on demand", tracks_.size() > on_demand_topics_above_ ? "yes" : "no");
   stat.add("observations received", received_);
   stat.add("observations for no tracked picker", unrouted_);
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());

@@ -44,7 +44,8 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "map_file",
         "map_timeout",      "frame_id",     "observation_topic", "topological_map", "max_future_stamp",
-        "person_observation_topic", "belief_topic_prefix", "bias_topic_prefix", "ordering_latency", "registry_topic"};
+        "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
+        "on_demand_topics_above", "demand_poll_period"};
     known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
     known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
                  PickerAssociationOptions::yamlKeys().end());

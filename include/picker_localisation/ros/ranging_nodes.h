@@ -5,8 +5,9 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/BearingDetectionArray.h>
+#include <picker_localisation/GnssBias.h>
 #include <picker_localisation/Observation.h>
-#include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerBeliefArray.h>
 #include <picker_localisation/PickerList.h>
 #include <picker_localisation/RfidReading.h>
 #include <picker_localisation/UwbRange.h>
@@ -24,6 +25,7 @@
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
+#include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/picker_association.h"
@@ -55,12 +57,13 @@ Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 // ~registry_topic "") the ~pickers_file is the list.
 // It also gives identity to anonymous people: Observations from every robot's leg_detector on
 // ~person_observation_topic are associated with the pickers (sensors::associatePerson, against each picker's
-// bias-corrected fix and its tracker's belief from /pickers/<id>/belief); a clear association is published as
+// bias-corrected fix and its belief from the tracker's stream ~belief_topic, /pickers/beliefs); a clear association is published as
 // an identifying observation of that picker and is a sighting for its GNSS bias estimate, an ambiguous one is
 // published unchanged. With ~ordering_latency > 0 (automatic: 0.2 s under /use_sim_time) fixes and people are
 // processed in stamp order, beliefs chosen by stamp (association_belief_lag), so a replayed bag gives the same
 // output twice; live (0) each message is processed on arrival. Publishes the bias per picker
-// (/pickers/<id>/gnss_bias, GnssBias) and rviz markers (~bias_markers: raw fix -> corrected fix).
+// (/pickers/<id>/gnss_bias, GnssBias; above ~on_demand_topics_above pickers only while someone subscribes, as
+// tpf_tracker's topics) and rviz markers (~bias_markers: raw fix -> corrected fix).
 class GnssIngestNode {
  public:
   GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
@@ -76,8 +79,9 @@ class GnssIngestNode {
     core::PickerConfig config;
     sensors::GnssIngest ingest;
     sensors::BeliefHistory beliefs;
-    ros::Subscriber fix_sub, belief_sub;
-    ros::Publisher bias_pub;
+    ros::Subscriber fix_sub;
+    LastValuePublisher<picker_localisation::GnssBias> bias_pub;
+    std::string bias_topic;  // resolved name
   };
   struct Input {
     bool is_fix = true;
@@ -87,11 +91,13 @@ class GnssIngestNode {
     core::Observation person;
   };
   void addPicker(const core::PickerConfig& p);
+  void advertiseBias(Picker& p);
+  void demandSweep();
   void onRegistry(const picker_localisation::PickerList::ConstPtr& msg);
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
   void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
-  void onBelief(const picker_localisation::PickerBelief::ConstPtr& msg, Picker* picker);
+  void onBelief(const picker_localisation::PickerBelief& msg);
   bool checkClock();
   std::vector<sensors::GnssIngest*> pickerPointers();
   std::vector<const sensors::BeliefHistory*> beliefHistories() const;
@@ -105,12 +111,13 @@ class GnssIngestNode {
   ros::NodeHandle nh_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::unique_ptr<sensors::GeodeticDatum> datum_;
-  std::string frame_id_, belief_prefix_, bias_prefix_;
+  std::string frame_id_, bias_prefix_;
   sensors::GnssIngestOptions options_;
   std::vector<std::unique_ptr<Picker>> pickers_;  // in the order of the list
   std::unordered_map<std::string, Picker*> by_id_;
   std::vector<ros::Subscriber> subs_;
-  ros::Publisher pub_, markers_pub_;
+  ros::Publisher pub_;
+  CountedPublisher markers_pub_;
   core::StampOrderedBuffer<Input> ordering_;
   double ordering_latency_ = 0.0;
   ros::Timer ordering_timer_;
@@ -118,6 +125,11 @@ class GnssIngestNode {
   ros::Timer diag_timer_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   StampGuard stamp_guard_;
+  std::size_t on_demand_topics_above_ = 100;
+  double demand_period_ = 2.0;
+  std::unique_ptr<TopicDemand> demand_;
+  std::uint64_t last_demand_poll_ = 0;
+  ros::WallTimer demand_timer_;
 };
 
 // rfid_ranging: RfidReading -> antenna pose from tf at the read's stamp -> RfidObservationModel.

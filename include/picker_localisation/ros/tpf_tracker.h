@@ -7,11 +7,14 @@
 // id, an empty tag or one another picker wears, a bad GNSS topic name, bad overrides) is refused with a
 // message and changes nothing. Started from a pickers file, the current list is latched on <prefix>/registry
 // (PickerList), which gnss_ingest follows (not with one ~picker_id, which names no GNSS topic).
-// Per picker: <prefix>/<id>/belief (PickerBelief, latched), <prefix>/<id>/estimate
+// Per picker: <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
 // (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
 // belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node highlighted;
-// built only while someone subscribes, the current one sent on connect); services <prefix>/<id>/reset
-// (ResetBelief) and <prefix>/<id>/what_if (WhatIf, on a copy of the filter); prefix ~topic_prefix = /pickers.
+// built only while someone subscribes); services <prefix>/<id>/reset (ResetBelief) and <prefix>/<id>/what_if
+// (WhatIf, on a copy of the filter); prefix ~topic_prefix = /pickers. Each topic behaves as latched (a new
+// subscriber gets the current message at once) but costs nothing while nobody listens (LastValuePublisher).
+// Every picker's beliefs also stream on <prefix>/beliefs (PickerBeliefArray, not latched): one connection for a
+// consumer of the whole fleet (gnss_ingest), and under load one message per burst of beliefs.
 // Routing: one subscription to ~observations_topic (/observations); each message is decoded once and goes to
 // the one filter it identifies, to its candidate pickers, or (anonymous, no candidates) to every filter
 // (core::concernsPicker's rule, by lookup).
@@ -22,6 +25,11 @@
 // 0.5 s under /use_sim_time (bags, simulator: deterministic replay), 0 live (each observation fused on
 // arrival, within milliseconds; one that arrives late, within reorder_window, is fused at the filter's
 // current time, as the filter documents). Clock jumps back reset every belief.
+// Above ~on_demand_topics_above pickers (default 100) the per-picker topics are advertised only while some node
+// subscribes to them (the master is polled every ~demand_poll_period, 2 s; a new subscriber gets the current
+// message on connect): roscpp's per-message cost grows with the publications of a process, and a farm's
+// thousands of unwatched topics made that cost larger than the filters'. Subscribe to any of them (rviz,
+// rostopic echo) and it appears within the poll period. The fleet stream is always advertised.
 // Diagnostics: one status for the fleet and one per picker.
 // Parameters (private): pickers_file or picker_id, map_file (else the latched topological_map topic),
 // tpf_params_file (YAML like config/tpf.yaml) overridden key by key by private parameters with the same
@@ -35,6 +43,7 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerBeliefArray.h>
 #include <picker_localisation/ResetBelief.h>
 #include <picker_localisation/WhatIf.h>
 #include <picker_localisation/AddPicker.h>
@@ -45,12 +54,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include <map>
+#include <optional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
+#include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
@@ -85,6 +96,12 @@ class TpfTracker {
 
  private:
   struct Track;  // one picker: filter, topics, services, counters
+  struct Outgoing {  // one belief's messages, queued by publish() and sent by flush()
+    Track* track;
+    picker_localisation::PickerBelief belief;
+    std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate;
+    std::optional<visualization_msgs::MarkerArray> markers;
+  };
   struct Pending {
     core::Observation obs;
     std::string sensor;
@@ -102,8 +119,12 @@ class TpfTracker {
   // Periodic predictions at lastStamp + k * period up to `until` (s).
   void predictDueUntil(Track& t, double until);
   void publish(Track& t);
+  void flush();
+  void flushWhenIdle();
   void publishRegistry();
   void updatePredictionTimer();
+  void advertiseTopics(Track& t);
+  void demandSweep();
   bool addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res);
   bool removePicker(picker_localisation::RemovePicker::Request& req,
                     picker_localisation::RemovePicker::Response& res);
@@ -125,6 +146,14 @@ class TpfTracker {
   std::map<std::string, std::unique_ptr<Track>> tracks_;
   ros::Subscriber sub_;
   ros::Publisher registry_pub_;
+  CountedPublisher fleet_pub_;
+  std::vector<Outgoing> outgoing_;
+  bool flush_scheduled_ = false;
+  std::size_t on_demand_topics_above_ = 100;
+  double demand_period_ = 2.0;
+  std::unique_ptr<TopicDemand> demand_;
+  std::uint64_t last_demand_poll_ = 0;
+  ros::WallTimer demand_timer_;
   ros::ServiceServer add_srv_, remove_srv_, list_srv_;
   ros::Timer prediction_timer_, diagnostics_timer_, ordering_timer_;
   double timer_period_ = 0.0;
