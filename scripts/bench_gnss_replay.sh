@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Benchmark (not a ctest): GNSS only, through the ROS graph on a replayed bag, against the node nearest the raw fix.
 # 1. farm_sim (3 pickers, GNSS only, config/sim.yaml's Table I errors, seed S) is recorded to a bag;
-# 2. the bag is replayed through launch/replay.launch (gnss_ingest -> one tpf_tracker per picker -> evaluator);
+# 2. the bag is replayed through launch/replay.launch (gnss_ingest -> tpf_tracker -> evaluator);
 # 3. the offline runner scores `raw_fix` (node nearest the latest accepted fix), `khan_connected` and `gnss_tpf` on
 #    the same seed and map (same pickers and fixes: the simulator is shared, see docs/readme/eval.md).
 # Prints one JSON object. Usage: scripts/bench_gnss_replay.sh MAP [DURATION=900] [SEED=1] [WORK_DIR]

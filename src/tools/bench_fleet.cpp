@@ -9,7 +9,8 @@
 // rss_mb, latency_p50_ms, latency_p99_ms, latency_max_ms, observations, beliefs, startup_s.
 //
 //   bench_fleet --pickers 1000 --rate 1 --duration 30 --particles 1000
-//   bench_fleet --pickers 100 --trackers per_picker   # one tpf_tracker process per picker, as before
+//   bench_fleet --pickers 100 --trackers per_picker   # one tpf_tracker process per picker (ordering 0.5 s), as
+//                                                     # before one node tracked them all
 //
 // Wall time is what is measured here (a live deployment); nothing in the nodes reads it.
 #include <arpa/inet.h>
@@ -132,6 +133,8 @@ pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
       dup2(fileno(f), 2);
     }
     setpgid(0, 0);
+    signal(SIGINT, SIG_DFL);  // a shell's background job inherits SIGINT ignored
+    signal(SIGTERM, SIG_DFL);
     std::vector<char*> args;
     for (const auto& s : argv) args.push_back(const_cast<char*>(s.c_str()));
     args.push_back(nullptr);
@@ -140,6 +143,17 @@ pid_t spawn(const std::vector<std::string>& argv, const fs::path& log) {
     _exit(127);
   }
   return pid;
+}
+
+// SIGINT, then SIGKILL when it has not ended within `grace` s.
+void stopProcess(pid_t pid, double grace = 10.0) {
+  kill(pid, SIGINT);
+  for (double waited = 0.0; waited < grace; waited += 0.05) {
+    if (waitpid(pid, nullptr, WNOHANG) == pid) return;
+    usleep(50000);
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
 }
 
 // utime + stime of a process (s) and its resident memory (MB), from /proc.
@@ -252,11 +266,9 @@ int main(int argc, char** argv) {
     std::vector<pid_t> all = tracker_pids;
     if (ingest > 0) all.push_back(ingest);
     for (pid_t p : all) kill(p, SIGINT);
-    for (pid_t p : all) waitpid(p, nullptr, 0);
-    if (master > 0) {
-      kill(master, SIGINT);
-      waitpid(master, nullptr, 0);
-    }
+    for (pid_t p : all) stopProcess(p);
+    ros::shutdown();  // unregister from the master while it still runs
+    if (master > 0) stopProcess(master);
     if (!a.keep) fs::remove_all(dir);
   };
   master = spawn({"rosmaster", "--core", "-p", std::to_string(port)}, dir / "rosmaster.log");
@@ -286,7 +298,8 @@ int main(int argc, char** argv) {
     tracker_pids.push_back(spawn(cmd, dir / "tpf_tracker.log"));
   } else {
     for (const std::string& id : ids) {
-      std::vector<std::string> cmd{tracker, "__name:=tpf_tracker_" + id, "_picker_id:=" + id};
+      // As the trackers ran before one node tracked them all: stamp order 0.5 s (the old default).
+      std::vector<std::string> cmd{tracker, "__name:=tpf_tracker_" + id, "_picker_id:=" + id, "_ordering_latency:=0.5"};
       cmd.insert(cmd.end(), common.begin(), common.end());
       tracker_pids.push_back(spawn(cmd, dir / ("tpf_tracker_" + id + ".log")));
     }
