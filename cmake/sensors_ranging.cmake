@@ -39,7 +39,7 @@ endforeach()
 # bench_fleet: N simulated pickers' NavSatFix through gnss_ingest into tpf_tracker on a private ROS master;
 # prints CPU, memory and fix -> belief latency as JSON (issue "Track a whole farm in one process").
 add_executable(bench_fleet src/tools/bench_fleet.cpp)
-target_link_libraries(bench_fleet picker_localisation_ros picker_localisation_sensors_ranging)
+target_link_libraries(bench_fleet picker_localisation_sensors_ranging_ros)
 target_compile_definitions(bench_fleet PRIVATE PL_SOURCE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 add_dependencies(bench_fleet ${PROJECT_NAME}_generate_messages_cpp gnss_ingest tpf_tracker)
 set_target_properties(bench_fleet PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})

@@ -2,14 +2,19 @@
 pl_add_gtest(test_sensors_ranging test/test_sensors_ranging.cpp LIBS picker_localisation_sensors_ranging)
 pl_add_gtest(test_gnss_bag test/test_gnss_bag.cpp LIBS picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_gnss_ingest_node test/gnss_ingest.test test/test_gnss_ingest_node.cpp)
-target_link_libraries(test_gnss_ingest_node picker_localisation_ros picker_localisation_sensors_ranging)
+target_link_libraries(test_gnss_ingest_node picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_rfid_ranging_node test/rfid_ranging.test test/test_rfid_ranging_node.cpp)
-target_link_libraries(test_rfid_ranging_node picker_localisation_ros)
+target_link_libraries(test_rfid_ranging_node picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_uwb_ranging_node test/uwb_ranging.test test/test_uwb_ranging_node.cpp)
-target_link_libraries(test_uwb_ranging_node picker_localisation_ros)
+target_link_libraries(test_uwb_ranging_node picker_localisation_sensors_ranging_ros)
 # rostest: the clock jumps back; gnss_ingest and tpf_tracker reset their time state and beliefs continue.
 if(TARGET tpf_tracker)
   add_rostest_gtest(test_clock_jump test/clock_jump.test test/test_clock_jump.cpp)
-  target_link_libraries(test_clock_jump picker_localisation_ros picker_localisation_sensors_ranging)
+  target_link_libraries(test_clock_jump picker_localisation_sensors_ranging_ros)
   add_dependencies(test_clock_jump gnss_ingest tpf_tracker)
 endif()
+
+# bench_fleet end to end (functional: JSON fields, every fix became a belief; no speed asserted).
+add_test(NAME bench_fleet_runs
+  COMMAND ${CATKIN_DEVEL_PREFIX}/env.sh ${CMAKE_CURRENT_SOURCE_DIR}/test/check_bench_fleet.sh $<TARGET_FILE:bench_fleet>)
+add_dependencies(tests bench_fleet)

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
 
 namespace ranging_test {
@@ -61,17 +62,7 @@ inline std::size_t countFor(const std::vector<picker_localisation::Observation>&
 // A good NavSatFix at map position p (diagonal covariance 1 m^2 east / north).
 inline sensor_msgs::NavSatFix fixAt(const picker_localisation::sensors::GeodeticDatum& datum, const Eigen::Vector2d& p,
                                     const ros::Time& stamp) {
-  sensor_msgs::NavSatFix f;
-  f.header.stamp = stamp;
-  f.header.frame_id = "gps";
-  const Eigen::Vector2d ll = datum.toLatLon(p);
-  f.latitude = ll.x();
-  f.longitude = ll.y();
-  f.altitude = 50.0;
-  f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
-  f.position_covariance = {1.0, 0, 0, 0, 1.0, 0, 0, 0, 4.0};
-  f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
-  return f;
+  return picker_localisation::ros_adapter::navSatFixAt(datum, p, stamp, 1.0);
 }
 
 }  // namespace ranging_test

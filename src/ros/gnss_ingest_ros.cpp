@@ -124,11 +124,7 @@ void GnssIngestNode::onRegistry(const picker_localisation::PickerList::ConstPtr&
   std::unordered_map<std::string, core::PickerConfig> wanted;
   std::vector<std::string> order;
   for (const auto& info : msg->pickers) {
-    core::PickerConfig c;
-    c.id = info.id;
-    c.gnss_topic = info.gnss_topic;
-    c.rfid_tags = info.rfid_tags;
-    c.uwb_tag = info.uwb_tag;
+    const core::PickerConfig c = fromMsg(info);
     std::string error;
     if (!core::pickerIdProblem(c.id).empty() ||
         (!c.gnss_topic.empty() && !ros::names::validate(c.gnss_topic, error))) {

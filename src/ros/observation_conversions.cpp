@@ -64,5 +64,23 @@ core::Observation fromMsg(const picker_localisation::Observation& msg, const top
   return obs;
 }
 
+picker_localisation::PickerInfo toMsg(const core::PickerConfig& picker) {
+  picker_localisation::PickerInfo m;
+  m.id = picker.id;
+  m.gnss_topic = picker.gnss_topic;
+  m.rfid_tags = picker.rfid_tags;
+  m.uwb_tag = picker.uwb_tag;
+  return m;
+}
+
+core::PickerConfig fromMsg(const picker_localisation::PickerInfo& msg) {
+  core::PickerConfig p;
+  p.id = msg.id;
+  p.gnss_topic = msg.gnss_topic;
+  p.rfid_tags = msg.rfid_tags;
+  p.uwb_tag = msg.uwb_tag;
+  return p;
+}
+
 }  // namespace ros_adapter
 }  // namespace picker_localisation

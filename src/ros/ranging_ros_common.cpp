@@ -9,6 +9,22 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+sensor_msgs::NavSatFix navSatFixAt(const sensors::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
+                                   const ros::Time& stamp, double sigma) {
+  sensor_msgs::NavSatFix f;
+  f.header.stamp = stamp;
+  f.header.frame_id = "gps";
+  const Eigen::Vector2d ll = datum.toLatLon(map_xy);
+  f.latitude = ll.x();
+  f.longitude = ll.y();
+  f.altitude = 50.0;
+  f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
+  const double v = sigma * sigma;
+  f.position_covariance = {v, 0, 0, 0, v, 0, 0, 0, 4.0 * v};
+  f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
+  return f;
+}
+
 sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg) {
   sensors::GnssFix f;
   f.stamp = msg.header.stamp.toSec();

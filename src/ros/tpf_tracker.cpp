@@ -565,31 +565,16 @@ void TpfTracker::flushWhenIdle() {
   }), reinterpret_cast<std::uint64_t>(this));
 }
 
-namespace {
-picker_localisation::PickerInfo toInfo(const core::PickerConfig& p) {
-  picker_localisation::PickerInfo m;
-  m.id = p.id;
-  m.gnss_topic = p.gnss_topic;
-  m.rfid_tags = p.rfid_tags;
-  m.uwb_tag = p.uwb_tag;
-  return m;
-}
-}  // namespace
-
 void TpfTracker::publishRegistry() {
   if (!registry_pub_) return;
   picker_localisation::PickerList m;
   m.header.stamp = ros::Time::now();
-  for (const core::PickerConfig& p : registry_.pickers()) m.pickers.push_back(toInfo(p));
+  for (const core::PickerConfig& p : registry_.pickers()) m.pickers.push_back(toMsg(p));
   registry_pub_.publish(m);
 }
 
 bool TpfTracker::addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res) {
-  core::PickerConfig p;
-  p.id = req.picker.id;
-  p.gnss_topic = req.picker.gnss_topic;
-  p.rfid_tags = req.picker.rfid_tags;
-  p.uwb_tag = req.picker.uwb_tag;
+  core::PickerConfig p = fromMsg(req.picker);
   p.tpf_overrides = req.tpf_overrides;
   std::string error;
   if (!p.gnss_topic.empty() && !ros::names::validate(p.gnss_topic, error)) error = "gnss_topic: " + error;
@@ -653,7 +638,7 @@ bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
 }
 
 bool TpfTracker::listPickers(picker_localisation::ListPickers::Request&, picker_localisation::ListPickers::Response& res) {
-  for (const core::PickerConfig& p : registry_.pickers()) res.pickers.push_back(toInfo(p));
+  for (const core::PickerConfig& p : registry_.pickers()) res.pickers.push_back(toMsg(p));
   return true;
 }
 

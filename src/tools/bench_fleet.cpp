@@ -43,6 +43,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
 #include "picker_localisation/topology/map_io.h"
 
@@ -398,16 +399,7 @@ int main(int argc, char** argv) {
     const std::size_t k = j % ids.size();
     const ros::WallTime stamp = ros::WallTime::now();
     const Eigen::Vector2d p = walkers[k].at(stamp.toSec() - t0) + Eigen::Vector2d(noise(rng), noise(rng));
-    sensor_msgs::NavSatFix f;
-    f.header.stamp = ros::Time(stamp.sec, stamp.nsec);
-    f.header.frame_id = "gps";
-    const Eigen::Vector2d ll = datum.toLatLon(p);
-    f.latitude = ll.x();
-    f.longitude = ll.y();
-    f.altitude = 50.0;
-    f.status.status = sensor_msgs::NavSatStatus::STATUS_FIX;
-    f.position_covariance = {1.0, 0, 0, 0, 1.0, 0, 0, 0, 4.0};
-    f.position_covariance_type = sensor_msgs::NavSatFix::COVARIANCE_TYPE_DIAGONAL_KNOWN;
+    const sensor_msgs::NavSatFix f = pl::ros_adapter::navSatFixAt(datum, p, ros::Time(stamp.sec, stamp.nsec));
     {
       std::lock_guard<std::mutex> lock(state[k].m);
       state[k].pending.push_back(f.header.stamp.toSec());

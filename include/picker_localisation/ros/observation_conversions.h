@@ -2,14 +2,20 @@
 #pragma once
 
 #include <picker_localisation/Observation.h>
+#include <picker_localisation/PickerInfo.h>
 
 #include "picker_localisation/core/observation.h"
+#include "picker_localisation/core/picker_registry.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
 picker_localisation::Observation toMsg(const core::Observation& obs, const topology::TopologicalMap& map,
                                        const std::string& frame_id = "map");
+
+// A picker of the deployment <-> PickerInfo (tpf_tracker's services and /pickers/registry; no tpf overrides).
+picker_localisation::PickerInfo toMsg(const core::PickerConfig& picker);
+core::PickerConfig fromMsg(const picker_localisation::PickerInfo& msg);
 
 // Converts a message. Node names not in the map are skipped and counted in *unknown_nodes (when given);
 // sizes that differ, non-finite values and the like are left for validateObservation() to report.

@@ -37,6 +37,10 @@ namespace ros_adapter {
 
 // sensor_msgs/NavSatFix -> core GnssFix (no checks: GnssIngest does them).
 sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg);
+// A good fix (STATUS_FIX, diagonal covariance sigma^2 horizontally, (2 sigma)^2 vertically, altitude 50 m) at a
+// map position, as a phone would send it (tests, bench_fleet).
+sensor_msgs::NavSatFix navSatFixAt(const sensors::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
+                                   const ros::Time& stamp, double sigma = 1.0);
 
 // Looks up `target <- source` at `stamp`, waiting at most `timeout` s. nullopt (and *error set) when the
 // transform is not available (unknown frame, extrapolation, empty frame id).
