@@ -99,6 +99,38 @@ TEST(PickerRegistry, BadFiles) {
   }
 }
 
+// Issue "Track a whole farm": ids must name topics, tags must not be empty; run-time add / remove change
+// nothing on a refusal; a file entry's tpf overrides are kept as YAML.
+TEST(PickerRegistry, IdsTagsAndRunTimeChanges) {
+  EXPECT_EQ(pickerIdProblem("picker_1"), "");
+  EXPECT_NE(pickerIdProblem(""), "");
+  EXPECT_NE(pickerIdProblem("1st"), "");
+  EXPECT_NE(pickerIdProblem("bad-id"), "");
+  EXPECT_NE(pickerIdProblem("a/b"), "");
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: bad-id}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, rfid_tags: ['']}]"), std::runtime_error);
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, tpf: 3}]"), std::runtime_error);
+  PickerRegistry r = PickerRegistry::parse("pickers: [{id: a, rfid_tags: [t1], tpf: {num_particles: 200}}, {id: b}]");
+  EXPECT_NE(r.find("a")->tpf_overrides.find("num_particles: 200"), std::string::npos);
+  EXPECT_EQ(r.find("b")->tpf_overrides, "");
+  PickerConfig c;
+  c.id = "c";
+  c.rfid_tags = {"t1"};  // worn by a
+  EXPECT_THROW(r.add(c), std::runtime_error);
+  c.id = "a";
+  c.rfid_tags = {"t3"};
+  EXPECT_THROW(r.add(c), std::runtime_error);  // duplicate id
+  EXPECT_EQ(r.ids(), (std::vector<std::string>{"a", "b"}));
+  c.id = "c";
+  r.add(c);
+  EXPECT_EQ(r.ids(), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_EQ(r.pickerForRfidTag("t3"), std::optional<std::string>("c"));
+  EXPECT_FALSE(r.remove("zz"));
+  EXPECT_TRUE(r.remove("a"));
+  EXPECT_EQ(r.ids(), (std::vector<std::string>{"b", "c"}));
+  EXPECT_FALSE(r.pickerForRfidTag("t1"));
+}
+
 #include "picker_localisation/core/stamp_ordered_buffer.h"
 
 TEST(StampOrderedBuffer, ReleasesInStampOrderAfterLatencyWhateverTheArrivalOrder) {

@@ -172,9 +172,15 @@ TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
     p.gnss_topic = topic;
     return p;
   };
+  // An invalid list (an id no topic can carry) is ignored whole: nothing changes.
   pl::PickerList list;
   list.pickers = {info("picker_1", "/pickers/picker_1/fix"), info("picker_4", "/pickers/picker_4/fix"),
                   info("bad-id", "/pickers/bad/fix")};
+  registry.publish(list);
+  ranging_test::spinFor(1.0);
+  EXPECT_EQ(fix4.getNumSubscribers(), 0u);
+  EXPECT_GT(fix1.getNumSubscribers(), 0u);
+  list.pickers.pop_back();
   registry.publish(list);
   ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() > 0; }, 10.0)) << "picker_4 not subscribed";
   ranging_test::spinFor(0.3);

@@ -4,6 +4,7 @@
 // pickers not read; diagnostics count the drops.
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
+#include <picker_localisation/PickerList.h>
 #include <picker_localisation/RfidReading.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
@@ -81,6 +82,33 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2"; }, 5.0)) << c.diag["dropped: no tf"];
   EXPECT_EQ(c.diag["rejected: unknown tag"], "1");
   EXPECT_EQ(c.diag["rejected: out of order"], "1");
+}
+
+// A picker added to the tracker at run time (its list on /pickers/registry): its tag is read as its own.
+TEST(RfidRangingNode, FollowsThePickerListOfTheTracker) {
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "RFID ranging");
+  ros::Publisher registry = nh.advertise<picker_localisation::PickerList>("/pickers/registry", 1, true);
+  ros::Publisher pub = nh.advertise<picker_localisation::RfidReading>("/robot_1/rfid", 50);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return pub.getNumSubscribers() > 0 && registry.getNumSubscribers() > 0; }, 30.0));
+  picker_localisation::PickerList list;
+  for (const auto& [id, tag] : std::vector<std::pair<std::string, std::string>>{{"picker_1", "rfid_0001"},
+                                                                                {"picker_9", "stranger"}}) {
+    picker_localisation::PickerInfo p;
+    p.id = id;
+    p.rfid_tags = {tag};
+    list.pickers.push_back(p);
+  }
+  registry.publish(list);
+  ranging_test::spinFor(1.0);
+  pub.publish(reading("stranger", "robot_1/rfid_antenna", ros::Time::now() + ros::Duration(5.0)));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return ranging_test::countFor(c.obs, "picker_9") >= 1; }, 10.0))
+      << "a read of the added picker's tag was not published as its observation";
+  for (const auto& o : c.obs)
+    if (o.picker_id == "picker_9") {
+      EXPECT_TRUE(o.identifying);
+      EXPECT_NEAR(o.position.x, 20.0, 1e-9);
+    }
 }
 
 int main(int argc, char** argv) {

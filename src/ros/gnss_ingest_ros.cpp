@@ -44,13 +44,12 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   if (!map_) return;
 
   options_ = o;
-  std::string topic, person_topic, registry_topic;
+  std::string topic, person_topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
   std::string belief_topic;
   pnh.param<std::string>("belief_topic", belief_topic, "/pickers/beliefs");
   pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
-  pnh.param<std::string>("registry_topic", registry_topic, "/pickers/registry");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
   on_demand_topics_above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
   demand_period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
@@ -64,9 +63,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
         belief_topic, 100, [this](const picker_localisation::PickerBeliefArray::ConstPtr& m) {
           for (const auto& b : m->beliefs) onBelief(b);
         }));
-  if (!registry_topic.empty())
-    subs_.push_back(nh.subscribe<picker_localisation::PickerList>(
-        registry_topic, 2, [this](const picker_localisation::PickerList::ConstPtr& m) { onRegistry(m); }));
+  subs_.push_back(followPickerList(nh, pnh, "gnss_ingest", [this](const core::PickerRegistry& r) { onRegistry(r); }));
   if (!person_topic.empty()) {  // with associate_people false the people are passed on unchanged
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
@@ -117,21 +114,15 @@ void GnssIngestNode::demandSweep() {
   for (auto& p : pickers_) advertiseBias(*p);
 }
 
-void GnssIngestNode::onRegistry(const picker_localisation::PickerList::ConstPtr& msg) {
+void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
   // The tracker's list is the truth: pickers it no longer tracks go, new ones (with a GNSS topic) come, one whose
   // topic changed is subscribed again.
   ++registry_updates_;
   std::unordered_map<std::string, core::PickerConfig> wanted;
   std::vector<std::string> order;
-  for (const auto& info : msg->pickers) {
-    const core::PickerConfig c = fromMsg(info);
-    std::string error;
-    if (!core::pickerIdProblem(c.id).empty() ||
-        (!c.gnss_topic.empty() && !ros::names::validate(c.gnss_topic, error))) {
-      ROS_WARN("gnss_ingest: picker list entry '%s' ignored: bad id or GNSS topic", c.id.c_str());
-      continue;
-    }
-    if (wanted.emplace(c.id, c).second) order.push_back(c.id);
+  for (const core::PickerConfig& c : registry.pickers()) {
+    wanted.emplace(c.id, c);
+    order.push_back(c.id);
   }
   std::size_t removed = 0, added = 0;
   for (auto it = pickers_.begin(); it != pickers_.end();) {

@@ -37,6 +37,10 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   updater_.setHardwareID("rfid_ranging");
   updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  registry_sub_ = followPickerList(nh, pnh, "rfid_ranging", [this](const core::PickerRegistry& r) {
+    model_->setRegistry(r);
+    ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());
+  });
   ok_ = true;
 }
 

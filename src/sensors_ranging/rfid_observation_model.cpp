@@ -58,7 +58,8 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "map_file",
                                             "pickers_file",
                                             "topological_map",
-                                            "max_future_stamp"};
+                                            "max_future_stamp",
+                                            "registry_topic"};
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
   }
   return o;  // value ranges: checked by RfidObservationModel's constructor (one line naming the key)

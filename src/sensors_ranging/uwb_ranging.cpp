@@ -182,5 +182,13 @@ core::Observation UwbRanging::makeObservation(const std::string& picker_id, cons
   return obs;
 }
 
+void UwbRanging::setRegistry(core::PickerRegistry registry) {
+  registry_ = std::move(registry);
+  for (auto it = tags_.begin(); it != tags_.end();) {
+    const std::optional<std::string> wearer = registry_.pickerForUwbTag(it->first);
+    it = wearer && *wearer == it->second.picker_id ? std::next(it) : tags_.erase(it);
+  }
+}
+
 }  // namespace sensors
 }  // namespace picker_localisation

@@ -16,6 +16,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -49,6 +50,11 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
                                                  double timeout, std::string* error);
 // The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
 std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
+// Follows tpf_tracker's picker list (~registry_topic, default /pickers/registry; "" = never): each valid list is
+// handed to `apply`; an invalid one (bad id, duplicate, a tag on two pickers) is ignored with one warning naming
+// `node` and the reason, the previous list stays.
+ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
+                                 std::function<void(const core::PickerRegistry&)> apply);
 // A list-of-strings parameter; also accepts one string ("[a, b]", "a b") as rosrun _name:=... gives it.
 std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
                                          const std::vector<std::string>& fallback);
@@ -97,7 +103,7 @@ class GnssIngestNode {
   void addPicker(const core::PickerConfig& p);
   void advertiseBias(Picker& p);
   void demandSweep();
-  void onRegistry(const picker_localisation::PickerList::ConstPtr& msg);
+  void onRegistry(const core::PickerRegistry& registry);
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
   void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
@@ -154,6 +160,7 @@ class RfidRangingNode {
   tf2_ros::Buffer tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::vector<ros::Subscriber> subs_;
+  ros::Subscriber registry_sub_;
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
@@ -188,6 +195,7 @@ class UwbRangingNode {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::map<std::string, Eigen::Isometry2d> mounts_;
   std::vector<ros::Subscriber> subs_;
+  ros::Subscriber registry_sub_;
   ros::Publisher pub_;
   ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;

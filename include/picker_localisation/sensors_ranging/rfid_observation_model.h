@@ -110,6 +110,9 @@ class RfidObservationModel {
   RfidResult process(const RfidRead& read);
   // Forgets every time state (read spells, last reads, failed attempts): after the clock jumped back.
   void reset();
+  // The pickers changed at run time (tpf_tracker's list): reads of a tag go to its wearer now, negative
+  // information to every picker now tracked.
+  void setRegistry(core::PickerRegistry registry) { registry_ = std::move(registry); }
   // Map nodes inside the read region of an antenna at pose (x, y, yaw), sorted: within regionRadius() (and the
   // beam).
   std::vector<topology::NodeIndex> nodesInReadRegion(const Eigen::Vector3d& antenna_pose) const;

@@ -99,6 +99,9 @@ class UwbRanging {
   const UwbCounters& counters() const { return counters_; }
   // Forgets every tag's batch and filter (after the clock jumped back); counters stay.
   void reset() { tags_.clear(); }
+  // The pickers changed at run time (tpf_tracker's list): a tag no longer worn by the same picker loses its
+  // filter (it would carry the old wearer's position).
+  void setRegistry(core::PickerRegistry registry);
   const RangeHistogramFilter* filter(const std::string& tag_id) const;  // nullptr before the tag's first update
   const UwbRangingOptions& options() const { return options_; }
 
