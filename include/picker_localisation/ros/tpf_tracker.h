@@ -6,7 +6,7 @@
 // ~remove_picker (RemovePicker) and ~list_pickers (ListPickers). A bad request (invalid, empty or duplicate
 // id, an empty tag or one another picker wears, a bad GNSS topic name, bad overrides) is refused with a
 // message and changes nothing. Started from a pickers file, the current list is latched on <prefix>/registry
-// (PickerList), which gnss_ingest follows (not with one ~picker_id, which names no GNSS topic).
+// (PickerList), which gnss_ingest, rfid_ranging and uwb_ranging follow (not with one ~picker_id, which names no GNSS topic).
 // Per picker: <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
 // (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
 // belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node highlighted;
