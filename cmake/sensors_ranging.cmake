@@ -44,3 +44,8 @@ target_compile_definitions(bench_fleet PRIVATE PL_SOURCE_DIR="${CMAKE_CURRENT_SO
 add_dependencies(bench_fleet ${PROJECT_NAME}_generate_messages_cpp gnss_ingest tpf_tracker)
 set_target_properties(bench_fleet PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_DEVEL_PREFIX}/${CATKIN_PACKAGE_BIN_DESTINATION})
 install(TARGETS bench_fleet RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
+
+# picker_fleet: gnss_ingest and tpf_tracker in one process (no socket between them).
+pl_add_node(picker_fleet src/nodes/picker_fleet_node.cpp)
+target_link_libraries(picker_fleet picker_localisation_sensors_ranging_ros picker_localisation_tpf_ros)
+add_dependencies(bench_fleet picker_fleet)

@@ -4,8 +4,9 @@
 # listening). Functional only: no figure of speed is asserted here.
 set -euo pipefail
 bench="$1"
-for listen in per_picker fleet; do
-  out=$("$bench" --pickers 5 --rate 2 --duration 3 --warmup 1 --particles 200 --listen "$listen" 2>/dev/null | tail -1)
+# The two processes listened to both ways, and gnss_ingest inside the tracker's process (picker_fleet).
+for mode in "--listen per_picker" "--listen fleet" "--listen fleet --trackers in_process"; do
+  out=$("$bench" --pickers 5 --rate 2 --duration 3 --warmup 1 --particles 200 $mode 2>/dev/null | tail -1)
   echo "$out"
   python3 - "$out" <<'PY'
 import json, sys

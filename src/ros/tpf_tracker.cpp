@@ -220,7 +220,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     // The pickers file's and picker_id's keys are this node's, not the filter's.
     for (const char* own : {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id",
                             "topic_prefix", "observations_topic", "ordering_latency", "max_future_stamp",
-                            "on_demand_topics_above", "demand_poll_period",
+                            "on_demand_topics_above", "demand_poll_period", "gnss_ingest",
                             "map_timeout", "map_topic"})
       base_params_.remove(own);
     tpf::TpfParams::fromYaml(base_params_);  // a bad shared value is one FATAL line, not one per picker

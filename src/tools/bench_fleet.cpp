@@ -100,9 +100,10 @@ bool parseArgs(int argc, char** argv, Args& a) {
   }
   if (a.pickers < 1 || a.rate <= 0.0 || a.duration <= 0.0 || a.warmup < 0.0 || a.particles < 1)
     throw std::runtime_error("--pickers, --rate, --duration, --particles must be positive");
-  if (a.trackers != "one" && a.trackers != "per_picker") throw std::runtime_error("--trackers: one or per_picker");
+  if (a.trackers != "one" && a.trackers != "per_picker" && a.trackers != "in_process")
+    throw std::runtime_error("--trackers: one, per_picker or in_process");
   if (a.listen != "per_picker" && a.listen != "fleet") throw std::runtime_error("--listen: per_picker or fleet");
-  if (a.listen == "fleet" && a.trackers != "one") throw std::runtime_error("--listen fleet needs --trackers one");
+  if (a.listen == "fleet" && a.trackers == "per_picker") throw std::runtime_error("--listen fleet needs one tracker");
   return true;
 }
 
@@ -281,23 +282,32 @@ int main(int argc, char** argv) {
     stopAll();
     return 1;
   }
-  ros::param::set("/gnss_ingest/pickers_file", (dir / "pickers.yaml").string());
-  ros::param::set("/gnss_ingest/datum_file", a.datum);
-  ros::param::set("/gnss_ingest/map_file", a.map);
-  if (std::system(("rosparam load '" + a.gnss_config + "' /gnss_ingest").c_str()) != 0) {
+  // gnss_ingest's parameters: its own node, or ~gnss_ingest/ of the one process (--trackers in_process).
+  const std::string ingest_ns = a.trackers == "in_process" ? "/tpf_tracker/gnss_ingest" : "/gnss_ingest";
+  ros::param::set(ingest_ns + "/pickers_file", (dir / "pickers.yaml").string());
+  ros::param::set(ingest_ns + "/datum_file", a.datum);
+  ros::param::set(ingest_ns + "/map_file", a.map);
+  if (std::system(("rosparam load '" + a.gnss_config + "' " + ingest_ns).c_str()) != 0) {
     std::cerr << "bench_fleet: rosparam load " << a.gnss_config << " failed\n";
     stopAll();
     return 1;
   }
-  ingest = spawn({(bin / "gnss_ingest").string(), "__name:=gnss_ingest"}, dir / "gnss_ingest.log");
   const std::string tracker = (bin / "tpf_tracker").string();
   const std::vector<std::string> common{"_map_file:=" + a.map, "_tpf_params_file:=" + a.tpf_config,
                                         "_num_particles:=" + std::to_string(a.particles)};
+  if (a.trackers == "in_process") {
+    std::vector<std::string> cmd{(bin / "picker_fleet").string(), "__name:=tpf_tracker",
+                                 "_pickers_file:=" + (dir / "pickers.yaml").string()};
+    cmd.insert(cmd.end(), common.begin(), common.end());
+    tracker_pids.push_back(spawn(cmd, dir / "picker_fleet.log"));
+  } else {
+    ingest = spawn({(bin / "gnss_ingest").string(), "__name:=gnss_ingest"}, dir / "gnss_ingest.log");
+  }
   if (a.trackers == "one") {
     std::vector<std::string> cmd{tracker, "__name:=tpf_tracker", "_pickers_file:=" + (dir / "pickers.yaml").string()};
     cmd.insert(cmd.end(), common.begin(), common.end());
     tracker_pids.push_back(spawn(cmd, dir / "tpf_tracker.log"));
-  } else {
+  } else if (a.trackers == "per_picker") {
     for (const std::string& id : ids) {
       // As the trackers ran before one node tracked them all: stamp order 0.5 s (the old default).
       std::vector<std::string> cmd{tracker, "__name:=tpf_tracker_" + id, "_picker_id:=" + id, "_ordering_latency:=0.5"};
@@ -379,6 +389,7 @@ int main(int argc, char** argv) {
   const double slot = 1.0 / (a.rate * ids.size());
   double cpu0 = 0.0, cpu0_ingest = 0.0, wall0 = 0.0;
   std::uint64_t published_window = 0, matched_at_measure = 0;
+  auto cpuOf = [](pid_t p) { return p > 0 ? cpuSeconds(p) : 0.0; };
   auto cpuTrackers = [&] {
     double c = 0.0;
     for (pid_t p : tracker_pids) c += cpuSeconds(p);
@@ -391,7 +402,7 @@ int main(int argc, char** argv) {
     if (due > now) ros::WallDuration(due - now).sleep();
     if (!measuring && due >= t_measure) {
       cpu0 = cpuTrackers();
-      cpu0_ingest = cpuSeconds(ingest);
+      cpu0_ingest = cpuOf(ingest);
       wall0 = ros::WallTime::now().toSec();
       matched_at_measure = matched;
       measuring = true;
@@ -408,8 +419,8 @@ int main(int argc, char** argv) {
     if (measuring) ++published_window;
   }
   const double wall1 = ros::WallTime::now().toSec();
-  const double cpu1 = cpuTrackers(), cpu1_ingest = cpuSeconds(ingest);
-  double rss = rssMb(ingest);
+  const double cpu1 = cpuTrackers(), cpu1_ingest = cpuOf(ingest);
+  double rss = ingest > 0 ? rssMb(ingest) : 0.0;
   for (pid_t p : tracker_pids) rss += rssMb(p);
   // Let the last beliefs arrive.
   for (int i = 0; i < 50 && matched - matched_at_measure < published_window; ++i) ros::WallDuration(0.1).sleep();
