@@ -51,9 +51,10 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   pnh.param<std::string>("belief_topic", belief_topic, "/pickers/beliefs");
   pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
-  on_demand_topics_above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
-  demand_period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
-  if (registry.size() > on_demand_topics_above_) demand_ = std::make_unique<TopicDemand>(demand_period_);
+  // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
+  on_demand_.start(nh, pnh, registry.size(), [this] { return pickers_.size(); }, [this] {
+    for (auto& p : pickers_) advertiseBias(*p);
+  });
   ordering_ = core::StampOrderedBuffer<Input>(ordering_latency_, 10000 + 20 * registry.size());
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 1000);
   markers_pub_ = CountedPublisher::advertise<visualization_msgs::MarkerArray>(pnh, "bias_markers", 2, {}, true);
@@ -79,8 +80,6 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   if (pickers_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
   ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
-  demand_timer_ = nh.createWallTimer(ros::WallDuration(std::max(0.1, demand_period_ / 2.0)),
-                                     [this](const ros::WallTimerEvent&) { demandSweep(); });
   updater_.setHardwareID("gnss_ingest");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
@@ -101,17 +100,8 @@ void GnssIngestNode::addPicker(const core::PickerConfig& p) {
 }
 
 void GnssIngestNode::advertiseBias(Picker& p) {
-  // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
-  const TopicDemand* demand = pickers_.size() > on_demand_topics_above_ ? demand_.get() : nullptr;
-  advertiseWhileWanted(p.bias_pub, p.bias_topic, demand, [&] { p.bias_pub.advertise(nh_, p.bias_topic, 5); });
-}
-
-void GnssIngestNode::demandSweep() {
-  if (pickers_.size() > on_demand_topics_above_ && !demand_) demand_ = std::make_unique<TopicDemand>(demand_period_);
-  const std::uint64_t polls = demand_ ? demand_->polls() : 0;
-  if (polls == last_demand_poll_ && (polls > 0 || demand_)) return;
-  last_demand_poll_ = polls;
-  for (auto& p : pickers_) advertiseBias(*p);
+  advertiseWhileWanted(p.bias_pub, p.bias_topic, on_demand_.demand(),
+                       [&] { p.bias_pub.advertise(nh_, p.bias_topic, 5); });
 }
 
 void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
@@ -239,19 +229,18 @@ void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstP
   ordering_.push(in.person.stamp, "sighting|" + msg->sensor + "|" + msg->picker_id + "|" + msg->robot_id, std::move(in));
 }
 
-void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& belief) {
-  const picker_localisation::PickerBelief* msg = &belief;
-  const auto it = by_id_.find(msg->picker_id);
+void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
+  const auto it = by_id_.find(msg.picker_id);
   if (it == by_id_.end()) return;  // a picker without GNSS here
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
-  for (std::size_t k = 0; k < msg->nodes.size() && k < msg->masses.size(); ++k) {
-    const auto n = map_->index(msg->nodes[k]);
-    if (!n || !std::isfinite(msg->masses[k]) || msg->masses[k] < 0.0) continue;
+  for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k) {
+    const auto n = map_->index(msg.nodes[k]);
+    if (!n || !std::isfinite(msg.masses[k]) || msg.masses[k] < 0.0) continue;
     nodes.push_back(*n);
-    masses.push_back(msg->masses[k]);
+    masses.push_back(msg.masses[k]);
   }
-  it->second->beliefs.push(msg->header.stamp.toSec(), nodes, masses);
+  it->second->beliefs.push(msg.header.stamp.toSec(), nodes, masses);
 }
 
 void GnssIngestNode::releaseOrdered() {

@@ -2,6 +2,7 @@
 
 #include <ros/master.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace picker_localisation {
@@ -42,6 +43,24 @@ void TopicDemand::run() {
     for (double waited = 0.0; waited < period_ && !stop_; waited += 0.05)
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+}
+
+void OnDemandTopics::start(ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::size_t expected,
+                           std::function<std::size_t()> pickers, std::function<void()> sweep) {
+  above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
+  period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
+  pickers_ = std::move(pickers);
+  sweep_ = std::move(sweep);
+  if (expected > above_) demand_ = std::make_unique<TopicDemand>(period_);
+  timer_ = nh.createWallTimer(ros::WallDuration(std::max(0.1, period_ / 2.0)), [this](const ros::WallTimerEvent&) { tick(); });
+}
+
+void OnDemandTopics::tick() {
+  if (onDemand() && !demand_) demand_ = std::make_unique<TopicDemand>(period_);
+  const std::uint64_t polls = demand_ ? demand_->polls() : 0;
+  if (polls == last_poll_ && (polls > 0 || demand_)) return;  // nothing new from the master
+  last_poll_ = polls;
+  sweep_();
 }
 
 }  // namespace ros_adapter

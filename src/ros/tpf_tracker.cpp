@@ -238,9 +238,11 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   pnh.param<std::string>("observations_topic", observations_topic, "/observations");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.5);
   stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
-  on_demand_topics_above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
-  demand_period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
-  if (registry_.size() > on_demand_topics_above_) demand_ = std::make_unique<TopicDemand>(demand_period_);
+  // Per-picker topics on demand above ~on_demand_topics_above pickers (see advertiseTopics).
+  on_demand_.start(nh, pnh, registry_.size(), [this] { return tracks_.size(); }, [this] {
+    flush();
+    for (auto& kv : tracks_) advertiseTopics(*kv.second);
+  });
   ordering_ = core::StampOrderedBuffer<Pending>(ordering_latency_, 10000 + 20 * registry_.size());
 
   const std::vector<core::PickerConfig> initial = registry_.pickers();
@@ -269,9 +271,6 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     ordering_timer_ = nh.createTimer(ros::Duration(std::min(0.05, ordering_latency_ / 4.0)),
                                      &TpfTracker::orderingTick, this);
   updatePredictionTimer();
-  // Per-picker topics on demand above ~on_demand_topics_above pickers (see advertiseTopics).
-  demand_timer_ = nh.createWallTimer(ros::WallDuration(std::max(0.1, demand_period_ / 2.0)),
-                                     [this](const ros::WallTimerEvent&) { demandSweep(); });
   diagnostics_.setHardwareID("tpf_tracker");
   diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
   diagnostics_timer_ =
@@ -357,7 +356,7 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
 
 void TpfTracker::advertiseTopics(Track& t) {
   // Few pickers: every topic always. A farm's worth: each while someone subscribes (the master polled).
-  const TopicDemand* demand = tracks_.size() > on_demand_topics_above_ ? demand_.get() : nullptr;
+  const TopicDemand* demand = on_demand_.demand();
   Track* raw = &t;
   advertiseWhileWanted(t.belief_pub, t.belief_topic, demand, [&] { t.belief_pub.advertise(nh_, t.belief_topic, 10); });
   advertiseWhileWanted(t.estimate_pub, t.estimate_topic, demand,
@@ -369,15 +368,6 @@ void TpfTracker::advertiseTopics(Track& t) {
           s.publish(toMarkers(raw->filter->belief(), *map_, raw->id, frame_id_));
         });
   });
-}
-
-void TpfTracker::demandSweep() {
-  if (tracks_.size() > on_demand_topics_above_ && !demand_) demand_ = std::make_unique<TopicDemand>(demand_period_);
-  const std::uint64_t polls = demand_ ? demand_->polls() : 0;
-  if (polls == last_demand_poll_ && (polls > 0 || demand_)) return;  // nothing new from the master
-  last_demand_poll_ = polls;
-  flush();
-  for (auto& kv : tracks_) advertiseTopics(*kv.second);
 }
 
 void TpfTracker::updatePredictionTimer() {
@@ -396,8 +386,13 @@ std::vector<TpfTracker::Track*> TpfTracker::route(bool identifying, const std::s
                                                   const std::vector<std::string>& candidates) {
   // core::concernsPicker's rule, by lookup: the picker identified, the candidates, or (anonymous) everyone.
   std::vector<Track*> out;
-  if (identifying || !candidates.empty()) {
-    for (const std::string& id : identifying ? std::vector<std::string>{picker_id} : candidates) {
+  if (identifying) {
+    const auto it = tracks_.find(picker_id);
+    if (it != tracks_.end()) out.push_back(it->second.get());
+    return out;
+  }
+  if (!candidates.empty()) {
+    for (const std::string& id : candidates) {
       const auto it = tracks_.find(id);
       if (it != tracks_.end()) out.push_back(it->second.get());
     }
@@ -656,7 +651,7 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
     advertised += kv.second->belief_pub.advertised() + kv.second->estimate_pub.advertised() +
                   kv.second->markers_pub.advertised();
   stat.add("per-picker topics advertised", advertised);
-  stat.add("per-picker topics on demand", tracks_.size() > on_demand_topics_above_ ? "yes" : "no");
+  stat.add("per-picker topics on demand", on_demand_.onDemand() ? "yes" : "no");
   stat.add("observations received", received_);
   stat.add("observations for no tracked picker", unrouted_);
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());

@@ -109,6 +109,32 @@ class TopicDemand {
   std::thread thread_;
 };
 
+// The on-demand policy of a node with per-picker topics (tpf_tracker, gnss_ingest): parameters
+// ~on_demand_topics_above (100) and ~demand_poll_period (2 s). Above that many pickers the master is polled
+// (TopicDemand) and `sweep` runs whenever a poll brought news; at or below it, `sweep` runs on every tick, so a
+// topic shut down while on demand is advertised again.
+class OnDemandTopics {
+ public:
+  OnDemandTopics() = default;
+  // `expected`: the pickers the node starts with (polling starts at once when they are many); `pickers`: how
+  // many it has now; `sweep`: re-applies advertiseWhileWanted to every per-picker topic.
+  void start(ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::size_t expected,
+             std::function<std::size_t()> pickers, std::function<void()> sweep);
+  bool onDemand() const { return pickers_ && pickers_() > above_; }
+  // What to advertise by: nullptr (always) unless on demand.
+  const TopicDemand* demand() const { return onDemand() ? demand_.get() : nullptr; }
+
+ private:
+  void tick();
+  std::size_t above_ = 100;
+  double period_ = 2.0;
+  std::function<std::size_t()> pickers_;
+  std::function<void()> sweep_;
+  std::unique_ptr<TopicDemand> demand_;
+  std::uint64_t last_poll_ = 0;
+  ros::WallTimer timer_;
+};
+
 // Keeps `pub` advertised on `topic` (resolved name) while it is wanted: always when `demand` is null, else while
 // the master lists a subscriber or the publisher still has one. `advertise` advertises it.
 template <class Publisher, class Advertise>

@@ -102,7 +102,6 @@ class GnssIngestNode {
   };
   void addPicker(const core::PickerConfig& p);
   void advertiseBias(Picker& p);
-  void demandSweep();
   void onRegistry(const core::PickerRegistry& registry);
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
@@ -135,11 +134,7 @@ class GnssIngestNode {
   ros::Timer diag_timer_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   StampGuard stamp_guard_;
-  std::size_t on_demand_topics_above_ = 100;
-  double demand_period_ = 2.0;
-  std::unique_ptr<TopicDemand> demand_;
-  std::uint64_t last_demand_poll_ = 0;
-  ros::WallTimer demand_timer_;
+  OnDemandTopics on_demand_;
 };
 
 // rfid_ranging: RfidReading -> antenna pose from tf at the read's stamp -> RfidObservationModel.

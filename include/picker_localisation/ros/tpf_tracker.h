@@ -124,7 +124,6 @@ class TpfTracker {
   void publishRegistry();
   void updatePredictionTimer();
   void advertiseTopics(Track& t);
-  void demandSweep();
   bool addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res);
   bool removePicker(picker_localisation::RemovePicker::Request& req,
                     picker_localisation::RemovePicker::Response& res);
@@ -149,11 +148,7 @@ class TpfTracker {
   CountedPublisher fleet_pub_;
   std::vector<Outgoing> outgoing_;
   bool flush_scheduled_ = false;
-  std::size_t on_demand_topics_above_ = 100;
-  double demand_period_ = 2.0;
-  std::unique_ptr<TopicDemand> demand_;
-  std::uint64_t last_demand_poll_ = 0;
-  ros::WallTimer demand_timer_;
+  OnDemandTopics on_demand_;
   ros::ServiceServer add_srv_, remove_srv_, list_srv_;
   ros::Timer prediction_timer_, diagnostics_timer_, ordering_timer_;
   double timer_period_ = 0.0;
