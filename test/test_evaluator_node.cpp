@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "picker_localisation/PickerBelief.h"
+#include "picker_localisation/PickerBeliefArray.h"
 #include "picker_localisation/TrackingError.h"
 #include "picker_localisation/topology/map_io.h"
 
@@ -16,7 +17,8 @@ namespace {
 
 struct Fixture {
   ros::NodeHandle nh;
-  ros::Publisher belief = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_1/belief", 10, true);
+  // The evaluator reads the trackers' fleet stream (its default ~belief_topic).
+  ros::Publisher belief = nh.advertise<picker_localisation::PickerBeliefArray>("/pickers/beliefs", 10, true);
   ros::Publisher truth = nh.advertise<geometry_msgs::PoseStamped>("/pickers/picker_1/ground_truth", 10, true);
   std::vector<picker_localisation::TrackingError> errors;
   ros::Subscriber sub = nh.subscribe<picker_localisation::TrackingError>(
@@ -29,7 +31,13 @@ struct Fixture {
     b.header.stamp = ros::Time::now();
     b.picker_id = "picker_1";
     b.estimated_node = node;
-    belief.publish(b);
+    picker_localisation::PickerBeliefArray fleet;
+    fleet.header = b.header;
+    picker_localisation::PickerBelief other = b;  // a picker the evaluator does not score: ignored
+    other.picker_id = "not_listed";
+    other.estimated_node = "NoSuchNode";
+    fleet.beliefs = {other, b};
+    belief.publish(fleet);
   }
   void sendTruth(double x, double y) {
     geometry_msgs::PoseStamped p;

@@ -10,6 +10,8 @@
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerBeliefArray.h>
+#include <picker_localisation/PickerList.h>
 #include <picker_localisation/WhatIf.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -76,6 +78,8 @@ void goalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
 }
 
 std::map<std::string, diagnostic_msgs::DiagnosticStatus> g_diagnostics;  // by hardware id
+ros::Publisher g_fleet_pub;                   // /pickers/beliefs (latched)
+picker_localisation::PickerBeliefArray g_fleet;
 
 void diagnosticsCallback(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -170,12 +174,15 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
 
   // Bad input: a belief of a map we do not have (unknown node names) for picker_3 is rejected, planning goes
   // on.
-  ros::Publisher b3 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_3/belief", 1, true);
   picker_localisation::PickerBelief bad;
   bad.picker_id = "picker_3";
   bad.nodes = {"NoSuchNode", "NotThisOneEither"};
   bad.masses = {0.5, std::nan("")};
-  b3.publish(bad);
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    g_fleet.beliefs.push_back(bad);
+    g_fleet_pub.publish(g_fleet);
+  }
   ASSERT_TRUE(waitFor(
       [] {
         std::lock_guard<std::mutex> lock(g_mutex);
@@ -221,17 +228,55 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
   for (const auto& [node, topics] : by_node) {
     if (node.find("nbs_planner") == std::string::npos) continue;
     ++planners;
-    EXPECT_TRUE(topics.count("/pickers/picker_1/belief")) << node;
+    // robot_3 reads each picker's topic (~belief_topic ""), the others the trackers' fleet stream.
+    if (node.find("robot_3") != std::string::npos)
+      EXPECT_TRUE(topics.count("/pickers/picker_1/belief")) << node;
+    else
+      EXPECT_TRUE(topics.count("/pickers/beliefs") && !topics.count("/pickers/picker_1/belief")) << node;
     for (const std::string& t : topics) {
       EXPECT_EQ(t.find("ground_truth"), std::string::npos) << node << " subscribes to " << t;
       const bool allowed =
           (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
+          t == "/pickers/beliefs" || t == "/pickers/registry" ||
           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
           t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }
   }
   EXPECT_EQ(planners, 4u);
+}
+
+// A picker the tracker adds at run time (its latched list on /pickers/registry) is planned for: its beliefs on
+// the fleet stream are counted; one the list dropped is no longer reported.
+TEST(NbsPlannerNode, FollowsThePickerListOfTheTracker) {
+  ros::NodeHandle nh;
+  ros::Subscriber diag = nh.subscribe("/diagnostics", 20, diagnosticsCallback);
+  ros::Publisher list_pub = nh.advertise<picker_localisation::PickerList>("/pickers/registry", 1, true);
+  picker_localisation::PickerList list;
+  for (const char* id : {"picker_1", "picker_2", "picker_9"}) {
+    picker_localisation::PickerInfo info;
+    info.id = id;
+    list.pickers.push_back(info);
+  }
+  list_pub.publish(list);
+  auto value = [](const std::string& robot, const std::string& key) -> std::string {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    auto it = g_diagnostics.find(robot);
+    if (it == g_diagnostics.end()) return "";
+    for (const auto& kv : it->second.values)
+      if (kv.key == key) return kv.value;
+    return "";
+  };
+  ASSERT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "0"; }, 15.0))
+      << "robot_1 never listed picker_9";
+  EXPECT_EQ(value("robot_1", "beliefs received picker_3"), "") << "picker_3 left the list";
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    g_fleet.beliefs.push_back(beliefMsg("picker_9", {g_confident_node}, {1.0}, g_confident_node));
+    g_fleet_pub.publish(g_fleet);
+  }
+  EXPECT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "1"; }, 15.0))
+      << "robot_1 counted " << value("robot_1", "beliefs received picker_9") << " beliefs of picker_9";
 }
 
 int main(int argc, char** argv) {
@@ -262,10 +307,15 @@ int main(int argc, char** argv) {
   g_filter->update(fix);
 
   ros::ServiceServer what_if = nh.advertiseService("/pickers/picker_2/what_if", whatIf);
+  // Both ways a planner reads beliefs: the trackers' fleet stream and each picker's own latched topic.
   ros::Publisher b1 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_1/belief", 1, true);
   ros::Publisher b2 = nh.advertise<picker_localisation::PickerBelief>("/pickers/picker_2/belief", 1, true);
-  b1.publish(beliefMsg("picker_1", {g_confident_node}, {1.0}, g_confident_node));
-  b2.publish(beliefMsg("picker_2", g_filter->belief()));
+  g_fleet_pub = nh.advertise<picker_localisation::PickerBeliefArray>("/pickers/beliefs", 1, true);
+  g_fleet.beliefs = {beliefMsg("picker_1", {g_confident_node}, {1.0}, g_confident_node),
+                     beliefMsg("picker_2", g_filter->belief())};
+  b1.publish(g_fleet.beliefs[0]);
+  b2.publish(g_fleet.beliefs[1]);
+  g_fleet_pub.publish(g_fleet);
 
   tf2_ros::StaticTransformBroadcaster tf;
   std::vector<geometry_msgs::TransformStamped> transforms;

@@ -41,14 +41,14 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     Picker& p = pickers_[i];
     p.id = registry.pickers()[i].id;
     const std::string base = "/pickers/" + p.id;
-    p.belief_sub = nh.subscribe<picker_localisation::PickerBelief>(
-        base + "/belief", 10,
-        [this, i](const picker_localisation::PickerBelief::ConstPtr& m) { onBelief(i, m); });
+    index_[p.id] = i;
     p.truth_sub = nh.subscribe<geometry_msgs::PoseStamped>(
         base + "/ground_truth", 10,
         [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) { onTruth(i, m); });
     p.error_pub = nh.advertise<picker_localisation::TrackingError>(base + "/error", 10);
   }
+  beliefs_ = std::make_unique<FleetBeliefs>(nh, pnh, [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
+  beliefs_->follow(registry.ids());
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
   sample_period_ = 1.0 / sample_rate;
@@ -62,8 +62,11 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   ok_ = true;
 }
 
-void Evaluator::onBelief(std::size_t i, const picker_localisation::PickerBelief::ConstPtr& msg) {
-  Picker& p = pickers_[i];
+void Evaluator::onBelief(const picker_localisation::PickerBelief& belief) {
+  const auto found = index_.find(belief.picker_id);
+  if (found == index_.end()) return;  // a picker this evaluation does not score
+  Picker& p = pickers_[found->second];
+  const picker_localisation::PickerBelief* msg = &belief;
   ++p.beliefs;
   if (msg->estimated_node.empty()) return;  // not initialised yet
   if (!map_->index(msg->estimated_node)) {

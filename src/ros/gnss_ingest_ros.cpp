@@ -47,8 +47,6 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   std::string topic, person_topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
-  std::string belief_topic;
-  pnh.param<std::string>("belief_topic", belief_topic, "/pickers/beliefs");
   pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
   // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
@@ -59,11 +57,10 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 1000);
   markers_pub_ = CountedPublisher::advertise<visualization_msgs::MarkerArray>(pnh, "bias_markers", 2, {}, true);
   for (const core::PickerConfig& p : registry.pickers()) addPicker(p);
-  if (o.association.enabled && o.association.belief_weight > 0.0 && !belief_topic.empty())
-    subs_.push_back(nh.subscribe<picker_localisation::PickerBeliefArray>(
-        belief_topic, 100, [this](const picker_localisation::PickerBeliefArray::ConstPtr& m) {
-          for (const auto& b : m->beliefs) onBelief(b);
-        }));
+  if (o.association.enabled && o.association.belief_weight > 0.0) {
+    beliefs_ = std::make_unique<FleetBeliefs>(nh, pnh, [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
+    beliefs_->follow(registry.ids());
+  }
   subs_.push_back(followPickerList(nh, pnh, "gnss_ingest", [this](const core::PickerRegistry& r) { onRegistry(r); }));
   if (!person_topic.empty()) {  // with associate_people false the people are passed on unchanged
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
@@ -130,6 +127,7 @@ void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
       addPicker(wanted[id]);
       ++added;
     }
+  if (beliefs_) beliefs_->follow(order);
   if (added + removed > 0)
     ROS_INFO("gnss_ingest: picker list from the tracker: %zu added, %zu removed, %zu with GNSS", added, removed,
              pickers_.size());

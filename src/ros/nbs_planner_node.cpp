@@ -86,17 +86,11 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   }
 
   // Inputs: the trackers' beliefs (never ground truth), the other robots' goals, the battery.
-  for (const core::PickerConfig& p : registry.pickers()) {
-    auto in = std::make_unique<PickerInput>();
-    in->id = p.id;
-    const std::size_t k = pickers_.size();
-    in->sub = nh_.subscribe<picker_localisation::PickerBelief>(
-        "/pickers/" + p.id + "/belief", 5,
-        [this, k](const picker_localisation::PickerBelief::ConstPtr& m) { beliefCallback(k, m); });
-    if (use_what_if_ && config.policy == nbs::Policy::kNextBestSense)
-      in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + p.id + "/what_if", true);
-    pickers_.push_back(std::move(in));
-  }
+  beliefs_ = std::make_unique<FleetBeliefs>(
+      nh_, pnh_, [this](const picker_localisation::PickerBelief& b) { beliefCallback(b); });
+  applyPickerList(registry.ids());
+  registry_sub_ = followPickerList(nh_, pnh_, name.c_str(),
+                                   [this](const core::PickerRegistry& r) { applyPickerList(r.ids()); });
   std::vector<std::string> fleet;
   if (!pnh_.getParam("fleet", fleet)) {
     int robots = 1;
@@ -120,26 +114,51 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     planOnce();
     diagnostics_.update();
   });
-  ROS_INFO("%s: robot %s, policy %s, %zu pickers, %zu other robots, planning every %.1f s", name.c_str(),
-           robot_id_.c_str(), nbs::toString(config.policy), pickers_.size(), peer_subs_.size(), period);
+  ROS_INFO("%s: robot %s, policy %s, %zu pickers (beliefs from %s), %zu other robots, planning every %.1f s",
+           name.c_str(), robot_id_.c_str(), nbs::toString(config.policy), pickers_.size(),
+           beliefs_->topic().c_str(), peer_subs_.size(), period);
   ok_ = true;
 }
 
-void NbsPlannerNode::beliefCallback(std::size_t k, const picker_localisation::PickerBelief::ConstPtr& msg) {
-  PickerInput& in = *pickers_[k];
+void NbsPlannerNode::applyPickerList(const std::vector<std::string>& ids) {
+  // The list is the truth: a picker that left takes its belief and what-if client with it.
+  std::vector<std::unique_ptr<PickerInput>> next;
+  for (const std::string& id : ids) {
+    auto it = std::find_if(pickers_.begin(), pickers_.end(), [&](const auto& in) { return in && in->id == id; });
+    if (it != pickers_.end()) {
+      next.push_back(std::move(*it));
+      continue;
+    }
+    auto in = std::make_unique<PickerInput>();
+    in->id = id;
+    if (use_what_if_ && planner_->config().policy == nbs::Policy::kNextBestSense)
+      in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + id + "/what_if", true);
+    next.push_back(std::move(in));
+  }
+  pickers_ = std::move(next);
+  by_id_.clear();
+  for (auto& in : pickers_) by_id_[in->id] = in.get();
+  beliefs_->follow(ids);
+}
+
+void NbsPlannerNode::beliefCallback(const picker_localisation::PickerBelief& msg) {
+  const auto found = by_id_.find(msg.picker_id);
+  if (found == by_id_.end()) {
+    ++beliefs_of_others_;
+    return;
+  }
+  PickerInput& in = *found->second;
   std::size_t rejected = 0;
-  const nbs::NodeMasses masses = massesFromBelief(*msg, *map_, &rejected);
-  if (masses.empty() || msg->picker_id != in.id) {
+  const nbs::NodeMasses masses = massesFromBelief(msg, *map_, &rejected);
+  if (masses.empty()) {
     ++in.rejected;
-    ROS_WARN_THROTTLE(10.0, "%s: rejected a belief of %s (%s)", ros::this_node::getName().c_str(),
-                      in.id.c_str(),
-                      msg->picker_id != in.id ? ("picker_id '" + msg->picker_id + "'").c_str()
-                                              : "no node of this map with a valid mass");
+    ROS_WARN_THROTTLE(10.0, "%s: rejected a belief of %s (no node of this map with a valid mass)",
+                      ros::this_node::getName().c_str(), in.id.c_str());
     return;
   }
   if (rejected > 0) ++in.rejected;
   ++in.received;
-  in.belief = *msg;
+  in.belief = msg;
 }
 
 void NbsPlannerNode::peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
@@ -333,6 +352,8 @@ bool NbsPlannerNode::getCandidates(picker_localisation::GetCandidates::Request& 
 }
 
 void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  stat.add("belief topic", beliefs_->topic());
+  stat.add("beliefs of pickers not listed", beliefs_of_others_);
   std::size_t with_belief = 0;
   for (const auto& in : pickers_) {
     if (in->belief) ++with_belief;

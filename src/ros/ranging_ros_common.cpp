@@ -101,30 +101,5 @@ Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
   return p;
 }
 
-ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
-                                 std::function<void(const core::PickerRegistry&)> apply) {
-  std::string topic;
-  pnh.param<std::string>("registry_topic", topic, "/pickers/registry");
-  if (topic.empty()) return ros::Subscriber();
-  const std::string name = node;
-  return nh.subscribe<picker_localisation::PickerList>(
-      topic, 2, [name, apply](const picker_localisation::PickerList::ConstPtr& msg) {
-        std::vector<core::PickerConfig> pickers;
-        std::string problem;
-        for (const auto& info : msg->pickers) {
-          pickers.push_back(fromMsg(info));
-          std::string error;
-          if (!info.gnss_topic.empty() && !ros::names::validate(info.gnss_topic, error))
-            problem = "picker '" + info.id + "': gnss_topic: " + error;
-        }
-        try {
-          if (!problem.empty()) throw std::runtime_error(problem);
-          apply(core::PickerRegistry(std::move(pickers), "picker list"));
-        } catch (const std::exception& e) {
-          ROS_WARN("%s: picker list ignored (the previous one stays): %s", name.c_str(), e.what());
-        }
-      });
-}
-
 }  // namespace ros_adapter
 }  // namespace picker_localisation

@@ -16,10 +16,12 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 
+#include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include <ros/ros.h>
 
 #include <deque>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,12 +51,12 @@ class Evaluator {
     std::optional<Eigen::Vector2d> truth;
     std::deque<std::pair<double, std::string>> belief_history;     // (stamp, estimated node), by arrival
     std::deque<std::pair<double, Eigen::Vector2d>> truth_history;  // (stamp, position)
-    ros::Subscriber belief_sub, truth_sub;
+    ros::Subscriber truth_sub;
     ros::Publisher error_pub;
     std::vector<eval::ErrorSample> samples;
     std::size_t beliefs = 0, truths = 0, unknown_nodes = 0, not_finite = 0;
   };
-  void onBelief(std::size_t i, const picker_localisation::PickerBelief::ConstPtr& msg);
+  void onBelief(const picker_localisation::PickerBelief& msg);
   void onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg);
   void onTimer(const ros::TimerEvent& ev);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -62,6 +64,8 @@ class Evaluator {
   bool ok_ = false, done_ = false, finished_ = false;
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::vector<Picker> pickers_;
+  std::map<std::string, std::size_t> index_;  // picker id -> pickers_ index
+  std::unique_ptr<FleetBeliefs> beliefs_;     // ~belief_topic: the fleet stream, or "" per picker
   double duration_ = 0.0;
   double first_truth_ = -1.0;  // ROS time of the first ground truth, s
   double sample_period_ = 1.0, ordering_latency_ = 1.5;

@@ -1,6 +1,7 @@
 // nbs_planner: the Next-Best-Sense planner of one robot (Navigate-and-Seek Sec. V), run in the robot's
-// namespace. Subscribes /pickers/<id>/belief (ids from ~pickers_file), the goals of the other robots of the
-// fleet
+// namespace. Reads the trackers' beliefs from their fleet stream ~belief_topic (/pickers/beliefs; "" = each
+// /pickers/<id>/belief) for the pickers of ~pickers_file, then of the tracker's list (~registry_topic,
+// /pickers/registry: pickers added or removed at run time), the goals of the other robots of the fleet
 // (/<robot_k>/goal) and, optionally, ~battery_topic; reads the robot pose from tf (map ->
 // <robot_id>/base_link). Every ~planning_period s of ROS time it plans (NextBestSensePlanner, policy nbs or
 // estimated_node) and publishes the goal on goal (GoalNode, latched) and the candidates' utilities on
@@ -27,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
@@ -47,7 +49,6 @@ class NbsPlannerNode {
  private:
   struct PickerInput {
     std::string id;
-    ros::Subscriber sub;
     ros::ServiceClient what_if;
     std::optional<picker_localisation::PickerBelief> belief;
     std::size_t received = 0, rejected = 0;
@@ -57,7 +58,8 @@ class NbsPlannerNode {
     ros::Time received;
   };
 
-  void beliefCallback(std::size_t picker, const picker_localisation::PickerBelief::ConstPtr& msg);
+  void beliefCallback(const picker_localisation::PickerBelief& msg);
+  void applyPickerList(const std::vector<std::string>& ids);
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg);
   bool getCandidates(picker_localisation::GetCandidates::Request& req,
@@ -77,7 +79,11 @@ class NbsPlannerNode {
   double tf_timeout_ = 0.2;
   bool use_what_if_ = true;
   int what_if_seed_ = 1;
-  std::vector<std::unique_ptr<PickerInput>> pickers_;
+  std::vector<std::unique_ptr<PickerInput>> pickers_;  // in the order of the list
+  std::map<std::string, PickerInput*> by_id_;
+  std::unique_ptr<FleetBeliefs> beliefs_;
+  ros::Subscriber registry_sub_;
+  std::size_t beliefs_of_others_ = 0;  // beliefs of pickers not in the list (the stream carries the whole fleet)
   std::vector<ros::Subscriber> peer_subs_;
   std::map<std::string, PeerGoal> peer_goals_;
   StampGuard clock_guard_;  // jump-back detection only

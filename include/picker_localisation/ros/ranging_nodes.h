@@ -26,6 +26,7 @@
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
+#include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
@@ -50,11 +51,6 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
                                                  double timeout, std::string* error);
 // The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
 std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
-// Follows tpf_tracker's picker list (~registry_topic, default /pickers/registry; "" = never): each valid list is
-// handed to `apply`; an invalid one (bad id, duplicate, a tag on two pickers) is ignored with one warning naming
-// `node` and the reason, the previous list stays.
-ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
-                                 std::function<void(const core::PickerRegistry&)> apply);
 // A list-of-strings parameter; also accepts one string ("[a, b]", "a b") as rosrun _name:=... gives it.
 std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
                                          const std::vector<std::string>& fallback);
@@ -125,6 +121,7 @@ class GnssIngestNode {
   std::vector<std::unique_ptr<Picker>> pickers_;  // in the order of the list
   std::unordered_map<std::string, Picker*> by_id_;
   std::vector<ros::Subscriber> subs_;
+  std::unique_ptr<FleetBeliefs> beliefs_;  // the trackers' beliefs (association_belief_weight > 0)
   ros::Publisher pub_;
   CountedPublisher markers_pub_;
   core::StampOrderedBuffer<Input> ordering_;

@@ -1,0 +1,53 @@
+// What a consumer of many pickers reads from the trackers (tpf_tracker publishes both): the picker list and
+// the beliefs. One place, so gnss_ingest, rfid_ranging, uwb_ranging, nbs_planner and the evaluator follow the
+// same topics with the same parameters.
+#pragma once
+
+#include <picker_localisation/PickerBelief.h>
+#include <picker_localisation/PickerBeliefArray.h>
+#include <ros/ros.h>
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "picker_localisation/core/picker_registry.h"
+
+namespace picker_localisation {
+namespace ros_adapter {
+
+// Follows tpf_tracker's picker list (~registry_topic, default /pickers/registry; "" = never): each valid list
+// is handed to `apply`; an invalid one (bad id, duplicate, a tag on two pickers) is ignored with one warning
+// naming `node` and the reason, the previous list stays.
+ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
+                                 std::function<void(const core::PickerRegistry&)> apply);
+
+// The trackers' beliefs. ~belief_topic (default /pickers/beliefs) is tpf_tracker's fleet stream
+// (PickerBeliefArray): one connection whatever the number of pickers. ~belief_topic "" reads each picker's
+// own latched /pickers/<id>/belief instead (trackers of another package, or a consumer started long after a
+// belief that does not change). Every belief reaches `on_belief`, whichever picker it names: the consumer
+// looks the id up.
+class FleetBeliefs {
+ public:
+  using Callback = std::function<void(const picker_localisation::PickerBelief&)>;
+  FleetBeliefs(ros::NodeHandle& nh, ros::NodeHandle& pnh, Callback on_belief);
+  FleetBeliefs(const FleetBeliefs&) = delete;  // the subscriptions call back into this object
+  FleetBeliefs& operator=(const FleetBeliefs&) = delete;
+  // The pickers to read: with per-picker topics, subscribes the new ones and drops the others; with the fleet
+  // stream nothing changes.
+  void follow(const std::vector<std::string>& ids);
+  bool perPicker() const { return topic_.empty(); }
+  // The topic read ("/pickers/<id>/belief" with per-picker topics).
+  std::string topic() const { return perPicker() ? "/pickers/<id>/belief" : topic_; }
+
+ private:
+  ros::NodeHandle nh_;
+  std::string topic_;
+  Callback on_belief_;
+  ros::Subscriber fleet_;
+  std::map<std::string, ros::Subscriber> per_picker_;
+};
+
+}  // namespace ros_adapter
+}  // namespace picker_localisation
