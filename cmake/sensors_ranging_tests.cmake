@@ -18,3 +18,11 @@ endif()
 add_test(NAME bench_fleet_runs
   COMMAND ${CATKIN_DEVEL_PREFIX}/env.sh ${CMAKE_CURRENT_SOURCE_DIR}/test/check_bench_fleet.sh $<TARGET_FILE:bench_fleet>)
 add_dependencies(tests bench_fleet)
+
+# rostest: the map of an LCAS robot (std_msgs/String JSON on /topological_map_2, datum in its meta, a
+# transformation); gnss_ingest and tpf_tracker take it from there and /picker_1/current_node is checked.
+if(TARGET tpf_tracker)
+  add_rostest_gtest(test_lcas_map test/lcas_map.test test/test_lcas_map.cpp)
+  target_link_libraries(test_lcas_map picker_localisation_sensors_ranging_ros)
+  add_dependencies(test_lcas_map gnss_ingest tpf_tracker)
+endif()

@@ -1,6 +1,8 @@
 // Map <-> message round trip and the map's markers (no roscore needed).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "picker_localisation/ros/map_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/topology/map_io.h"
@@ -23,6 +25,21 @@ TEST(MapConversions, RoundTripKeepsNodesEdgesAndLanes) {
     EXPECT_EQ(back.laneNameOf(i), map.laneNameOf(i));
     EXPECT_DOUBLE_EQ(back.node(i).position.x(), map.node(i).position.x());
   }
+}
+
+TEST(MapConversions, DatumTravelsWithTheMap) {
+  topology::TopologicalMap map = topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  EXPECT_FALSE(ros_adapter::toMsg(map, "map").has_datum);
+  map.setDatum(topology::MapDatum{53.268, -0.524, 7.0});
+  picker_localisation::TopologicalMap msg = ros_adapter::toMsg(map, "map");
+  EXPECT_TRUE(msg.has_datum);
+  const topology::TopologicalMap back = ros_adapter::fromMsg(msg);
+  ASSERT_TRUE(back.datum().has_value());
+  EXPECT_DOUBLE_EQ(back.datum()->latitude, 53.268);
+  EXPECT_DOUBLE_EQ(back.datum()->longitude, -0.524);
+  EXPECT_DOUBLE_EQ(back.datum()->altitude, 7.0);
+  msg.datum_latitude = std::nan("");
+  EXPECT_THROW(ros_adapter::fromMsg(msg), topology::MapError);
 }
 
 TEST(MapConversions, BadEdgeIndexIsAnError) {

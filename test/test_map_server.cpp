@@ -16,7 +16,7 @@ boost::shared_ptr<const M> waitLatched(const std::string& topic) {
 
 TEST(MapServer, LatchedMap) {
   ros::Duration(0.5).sleep();  // connect after the server published
-  auto map = waitLatched<picker_localisation::TopologicalMap>("/topological_map");
+  auto map = waitLatched<picker_localisation::TopologicalMap>("/picker_localisation/topological_map");
   ASSERT_TRUE(map);
   EXPECT_EQ(map->nodes.size(), 138u);
   EXPECT_EQ(map->edges.size(), 308u);

@@ -44,7 +44,7 @@ TEST(RobotLaunch, EveryNodeUpWithoutSimulator) {
 }
 
 TEST(RobotLaunch, OutputsAdvertisedAndNoSimulation) {
-  auto map = ros::topic::waitForMessage<picker_localisation::TopologicalMap>("/topological_map", ros::Duration(30));
+  auto map = ros::topic::waitForMessage<picker_localisation::TopologicalMap>("/picker_localisation/topological_map", ros::Duration(30));
   ASSERT_TRUE(map);
   EXPECT_EQ(map->nodes.size(), 138u);
   std::set<std::string> t;

@@ -281,3 +281,46 @@ TEST(MapCopy, CopiesAreIndependentAndQueryable) {
   EXPECT_EQ(c.nearestNode(m.position2d(5)), 5u);
   EXPECT_EQ(c.hopDistance(0, 17), m.hopDistance(0, 17));
 }
+
+// tmap2 `transformation` (LCAS: node poses in its child frame) and the datum of meta.datum_*.
+TEST(Tmap2Loader, TransformationAndDatum) {
+  const std::string nodes =
+      "nodes:\n"
+      "- node: {name: A, pose: {position: {x: 1, y: 0}, orientation: {w: 1}}, edges: [{edge_id: A_B, node: B}]}\n"
+      "- node: {name: B, pose: {position: {x: 1, y: 2}}}\n";
+  const TopologicalMap plain = parseMap(nodes, "plain");
+  EXPECT_FALSE(plain.datum().has_value());
+  EXPECT_DOUBLE_EQ(plain.position2d(0).x(), 1.0);
+  // 90 degrees about z, then (10, -5): (1, 0) -> (10, -4), (1, 2) -> (8, -4).
+  const double h = std::sqrt(0.5);
+  const std::string turned = nodes +
+                             "meta: {last_updated: x, datum_latitude: 53.25, datum_longitude: -0.5, datum_altitude: 12}\n"
+                             "transformation: {child: topo_map, parent: map, rotation: {w: " +
+                             std::to_string(h) + ", x: 0, y: 0, z: " + std::to_string(h) +
+                             "}, translation: {x: 10, y: -5, z: 0}}\n";
+  const TopologicalMap m = parseMap(turned, "turned");
+  EXPECT_NEAR(m.position2d(0).x(), 10.0, 1e-5);
+  EXPECT_NEAR(m.position2d(0).y(), -4.0, 1e-5);
+  EXPECT_NEAR(m.position2d(1).x(), 8.0, 1e-5);
+  EXPECT_NEAR(m.position2d(1).y(), -4.0, 1e-5);
+  // The node's heading turns with the frame (identity -> 90 degrees about z).
+  EXPECT_NEAR(m.node(0).orientation[2], h, 1e-5);
+  EXPECT_NEAR(m.node(0).orientation[3], h, 1e-5);
+  ASSERT_TRUE(m.datum().has_value());
+  EXPECT_DOUBLE_EQ(m.datum()->latitude, 53.25);
+  EXPECT_DOUBLE_EQ(m.datum()->longitude, -0.5);
+  EXPECT_DOUBLE_EQ(m.datum()->altitude, 12.0);
+  // A copy keeps the datum; the shipped map (identity transformation, no datum) is unchanged.
+  const TopologicalMap copy = m;
+  EXPECT_TRUE(copy.datum().has_value());
+  const TopologicalMap riseholme = loadMap(kTmap2);
+  EXPECT_FALSE(riseholme.datum().has_value());
+  // Bad values: one line naming the field.
+  EXPECT_NE(errorOf(nodes + "transformation: {rotation: {w: 0, x: 0, y: 0, z: 0}}\n").find("transformation.rotation"),
+            std::string::npos);
+  EXPECT_NE(errorOf(nodes + "transformation: {translation: {x: abc}}\n").find("transformation.translation.x"),
+            std::string::npos);
+  EXPECT_NE(errorOf(nodes + "meta: {datum_latitude: 53.2}\n").find("meta.datum_longitude"), std::string::npos);
+  EXPECT_NE(errorOf(nodes + "meta: {datum_latitude: 95, datum_longitude: 0}\n").find("out of range"),
+            std::string::npos);
+}

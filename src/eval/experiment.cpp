@@ -324,7 +324,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     const sim::PickerSpec& ps = simulator.pickerSpec(i);
     tracks[i].id = ps.id;
     tracks[i].gnss = std::make_unique<sensors::GnssIngest>(ps.id, map, datum, gnss_options);
-    registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag});
+    registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag, ""});
   }
   const core::PickerRegistry registry(registry_entries);
   // What gnss_ingest keeps of the trackers' published beliefs (the association reads them with a lag).

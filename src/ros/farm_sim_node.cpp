@@ -82,6 +82,8 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   pnh_.param<std::string>("urdf_template", urdf_template, "");
   pnh_.param<std::string>("pickers_file", pickers_file, "");
   pnh_.param<std::string>("datum_file", datum_file, "");
+  std::string datum_source;
+  pnh_.param<std::string>("datum_source", datum_source, "auto");
   try {
     if (!sim_config.empty()) config = sim::loadSimConfig(sim_config);
     if (!datum_file.empty()) config.datum = sim::loadMapDatum(datum_file);
@@ -128,6 +130,13 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
 
   map_ = obtainMap(nh_, pnh_);
   if (!map_) return;
+  if (map_->datum() && datum_source != "file") {  // as gnss_ingest (~datum_source auto): the map's own datum wins
+    config.datum.latitude = map_->datum()->latitude;
+    config.datum.longitude = map_->datum()->longitude;
+    config.datum.altitude = map_->datum()->altitude;
+    config.datum.heading_deg = 0.0;
+    ROS_INFO("farm_sim: fixes use the map's datum (%.7f, %.7f)", config.datum.latitude, config.datum.longitude);
+  }
   try {
     sim_ = std::make_unique<sim::FarmSimulator>(*map_, config);
   } catch (const std::exception& e) {

@@ -22,15 +22,11 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  std::string datum_file;
-  if (!pnh.getParam("datum_file", datum_file)) {
-    ROS_FATAL("gnss_ingest: parameter ~datum_file (config/datum.yaml) is required");
-    return;
-  }
-  try {
-    datum_ = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
-  } catch (const std::exception& e) {
-    ROS_FATAL("gnss_ingest: %s", e.what());
+  std::string datum_file, datum_source;
+  pnh.param<std::string>("datum_file", datum_file, "");
+  pnh.param<std::string>("datum_source", datum_source, "auto");
+  if (datum_source != "auto" && datum_source != "file" && datum_source != "map") {
+    ROS_FATAL("gnss_ingest: ~datum_source '%s' must be auto, file or map", datum_source.c_str());
     return;
   }
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
@@ -42,6 +38,30 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   pnh.param("map_timeout", map_timeout, map_timeout);
   map_ = obtainMap(nh, pnh, map_timeout);
   if (!map_) return;
+  // The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
+  // when the map has none.
+  try {
+    if (datum_source == "map" || (datum_source == "auto" && map_->datum())) {
+      if (!map_->datum()) throw std::runtime_error("~datum_source is map but the map has no meta.datum_latitude");
+      sensors::DatumConfig c;
+      c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
+      c.latitude = map_->datum()->latitude;
+      c.longitude = map_->datum()->longitude;
+      c.altitude = map_->datum()->altitude;
+      datum_ = std::make_unique<sensors::GeodeticDatum>(c);
+      ROS_INFO("gnss_ingest: datum from the map (%.7f, %.7f, %.1f m; ~datum_source file uses %s instead)",
+               c.latitude, c.longitude, c.altitude, datum_file.empty() ? "~datum_file" : datum_file.c_str());
+    } else {
+      if (datum_file.empty())
+        throw std::runtime_error("parameter ~datum_file (config/datum.yaml) is required: the map has no datum");
+      datum_ = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
+      ROS_INFO("gnss_ingest: datum from %s%s", datum_file.c_str(),
+               map_->datum() ? " (~datum_source file: the map's own datum is not used)" : "");
+    }
+  } catch (const std::exception& e) {
+    ROS_FATAL("gnss_ingest: %s", e.what());
+    return;
+  }
 
   options_ = o;
   std::string topic, person_topic;

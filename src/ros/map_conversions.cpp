@@ -23,6 +23,12 @@ picker_localisation::TopologicalMap toMsg(const topology::TopologicalMap& map, c
   msg.name = map.name();
   msg.metric_map = map.metricMap();
   msg.source_file = map.source();
+  if (map.datum()) {
+    msg.has_datum = true;
+    msg.datum_latitude = map.datum()->latitude;
+    msg.datum_longitude = map.datum()->longitude;
+    msg.datum_altitude = map.datum()->altitude;
+  }
   msg.nodes.reserve(map.numNodes());
   for (topology::NodeIndex i = 0; i < map.numNodes(); ++i) {
     picker_localisation::TopologicalNode n;
@@ -67,8 +73,17 @@ topology::TopologicalMap fromMsg(const picker_localisation::TopologicalMap& msg)
                                "edge '" + e.edge_id + "' has a node index out of range", "", "edges");
     edges.push_back({e.edge_id, msg.nodes[e.source].name, msg.nodes[e.target].name, e.action});
   }
-  return topology::TopologicalMap::build(msg.name, std::move(nodes), edges,
-                                         msg.source_file.empty() ? "<message>" : msg.source_file, msg.metric_map);
+  topology::TopologicalMap map = topology::TopologicalMap::build(
+      msg.name, std::move(nodes), edges, msg.source_file.empty() ? "<message>" : msg.source_file, msg.metric_map);
+  if (msg.has_datum) {
+    if (!std::isfinite(msg.datum_latitude) || !std::isfinite(msg.datum_longitude) ||
+        std::abs(msg.datum_latitude) > 90.0 || std::abs(msg.datum_longitude) > 180.0)
+      throw topology::MapError(msg.source_file.empty() ? "<message>" : msg.source_file,
+                               "datum latitude / longitude not finite or out of range", "", "datum");
+    map.setDatum(topology::MapDatum{msg.datum_latitude, msg.datum_longitude,
+                                    std::isfinite(msg.datum_altitude) ? msg.datum_altitude : 0.0});
+  }
+  return map;
 }
 
 std_msgs::ColorRGBA laneColour(int lane) {

@@ -1,6 +1,7 @@
 #include "picker_localisation/ros/topological_map_server.h"
 
 #include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/topology/map_io.h"
 
 namespace picker_localisation {
@@ -21,7 +22,8 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
     const topology::TopologicalMap map = topology::loadMap(map_file);
     msg_ = toMsg(map, frame_id);
     msg_.header.stamp = ros::Time::now();
-    map_pub_ = nh.advertise<picker_localisation::TopologicalMap>("topological_map", 1, /*latch=*/true);
+    // Not /topological_map: LCAS topological_navigation publishes its own type there.
+    map_pub_ = nh.advertise<picker_localisation::TopologicalMap>(kMapTopic, 1, /*latch=*/true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("topological_map/markers", 1, /*latch=*/true);
     service_ = nh.advertiseService("get_topological_map", &TopologicalMapServer::serveMap, this);
     map_pub_.publish(msg_);

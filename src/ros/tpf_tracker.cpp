@@ -1,6 +1,7 @@
 #include "picker_localisation/ros/tpf_tracker.h"
 
 #include <picker_localisation/PickerList.h>
+#include <std_msgs/String.h>
 #include <boost/make_shared.hpp>
 #include <ros/callback_queue.h>
 #include <ros/names.h>
@@ -194,11 +195,13 @@ struct TpfTracker::Track {
   double prediction_period = 0.0;  // s; 0: no periodic prediction
   LastValuePublisher<picker_localisation::PickerBelief> belief_pub;
   LastValuePublisher<geometry_msgs::PoseWithCovarianceStamped> estimate_pub;
+  LastValuePublisher<std_msgs::String> current_node_pub;  // LCAS coordination's <agent>/current_node
+  std::string current_node;                               // the last one published
   CountedPublisher markers_pub;
   ros::ServiceServer reset_srv, what_if_srv;
   std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0;
   std::string last_problem;
-  std::string belief_topic, estimate_topic, markers_topic;  // resolved names
+  std::string belief_topic, estimate_topic, markers_topic, current_node_topic;  // resolved names ("": none)
 };
 
 TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
@@ -235,6 +238,9 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
 
   std::string observations_topic;
   pnh.param<std::string>("topic_prefix", prefix_, "/pickers");
+  // LCAS topological_navigation's coordination reads an agent's node from <agent>/current_node (std_msgs/String):
+  // <current_node_namespace>/<id>/current_node, so "/" gives /<id>/current_node; "" publishes none.
+  pnh.param<std::string>("current_node_namespace", current_node_ns_, prefix_);
   pnh.param<std::string>("observations_topic", observations_topic, "/observations");
   ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.5);
   stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
@@ -301,6 +307,9 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
   t->belief_topic = nh_.resolveName(base + "/belief");
   t->estimate_topic = nh_.resolveName(base + "/estimate");
   t->markers_topic = nh_.resolveName(base + "/markers");
+  if (!current_node_ns_.empty())
+    t->current_node_topic =
+        nh_.resolveName((current_node_ns_ == "/" ? std::string() : current_node_ns_) + "/" + picker.id + "/current_node");
   advertiseTopics(*t);
   t->reset_srv = nh_.advertiseService<picker_localisation::ResetBelief::Request, picker_localisation::ResetBelief::Response>(
       base + "/reset", [this, raw](picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res) {
@@ -361,6 +370,9 @@ void TpfTracker::advertiseTopics(Track& t) {
   advertiseWhileWanted(t.belief_pub, t.belief_topic, demand, [&] { t.belief_pub.advertise(nh_, t.belief_topic, 10); });
   advertiseWhileWanted(t.estimate_pub, t.estimate_topic, demand,
                        [&] { t.estimate_pub.advertise(nh_, t.estimate_topic, 10); });
+  if (!t.current_node_topic.empty())
+    advertiseWhileWanted(t.current_node_pub, t.current_node_topic, demand,
+                         [&] { t.current_node_pub.advertise(nh_, t.current_node_topic, 2); });
   // Markers are built only for a subscriber (rviz); a new one gets the current markers at once.
   advertiseWhileWanted(t.markers_pub, t.markers_topic, demand, [&] {
     t.markers_pub = CountedPublisher::advertise<visualization_msgs::MarkerArray>(
@@ -506,8 +518,14 @@ void TpfTracker::publish(Track& t) {
   // Queued, sent by flush(): messages published back to back cost roscpp's poll thread one walk over every
   // publication of the process, not one walk each.
   const tpf::Belief& b = t.filter->belief();
-  Outgoing out{&t, toBeliefMsg(b, *map_, t.id, frame_id_), std::nullopt, std::nullopt};
+  Outgoing out{&t, toBeliefMsg(b, *map_, t.id, frame_id_), std::nullopt, std::nullopt, std::nullopt};
   if (b.initialised) out.estimate = toEstimateMsg(b, *map_, frame_id_);
+  if (b.initialised && !t.current_node_topic.empty() && map_->node(b.map_node).name != t.current_node) {
+    t.current_node = map_->node(b.map_node).name;  // sent on change, latched (as LCAS agents do)
+    std_msgs::String node;
+    node.data = t.current_node;
+    out.current_node = node;
+  }
   if (t.markers_pub.hasSubscribers()) out.markers = toMarkers(b, *map_, t.id, frame_id_);
   outgoing_.push_back(std::move(out));
 }
@@ -520,6 +538,7 @@ void TpfTracker::flush() {
     if (to_fleet) fleet.beliefs.push_back(o.belief);
     o.track->belief_pub.publish(std::move(o.belief));
     if (o.estimate) o.track->estimate_pub.publish(std::move(*o.estimate));
+    if (o.current_node) o.track->current_node_pub.publish(std::move(*o.current_node));
     if (o.markers) o.track->markers_pub.publish(*o.markers);
   }
   outgoing_.clear();
@@ -649,7 +668,7 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
   std::size_t advertised = 0;
   for (const auto& kv : tracks_)
     advertised += kv.second->belief_pub.advertised() + kv.second->estimate_pub.advertised() +
-                  kv.second->markers_pub.advertised();
+                  kv.second->markers_pub.advertised() + kv.second->current_node_pub.advertised();
   stat.add("per-picker topics advertised", advertised);
   stat.add("per-picker topics on demand", on_demand_.onDemand() ? "yes" : "no");
   stat.add("observations received", received_);

@@ -57,7 +57,7 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "map_timeout",
                                             "map_file",
                                             "pickers_file",
-                                            "topological_map",
+                                            "map_topic",
                                             "max_future_stamp",
                                             "registry_topic"};
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));

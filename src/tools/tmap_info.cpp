@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
     char bbox[160];
     std::snprintf(bbox, sizeof(bbox), "bbox: [%.3f, %.3f, %.3f, %.3f]", b.min_x, b.min_y, b.max_x, b.max_y);
     std::cout << bbox << "   # min_x, min_y, max_x, max_y (m)\n";
+    if (const auto& d = map.datum()) {
+      char datum[160];
+      std::snprintf(datum, sizeof(datum), "datum: [%.7f, %.7f, %.2f]", d->latitude, d->longitude, d->altitude);
+      std::cout << datum << "   # meta.datum_latitude, _longitude (deg), _altitude (m)\n";
+    }
     return 0;
   } catch (const MapError& e) {
     std::cerr << "tmap_info: " << e.what() << "\n";

@@ -1,5 +1,8 @@
 #include "picker_localisation/topology/map_io.h"
 
+#include <Eigen/Geometry>
+#include <optional>
+
 #include <yaml-cpp/yaml.h>
 
 #if defined(__GLIBC__)
@@ -53,7 +56,14 @@ class MapReader {
     for (const YAML::Node& entry : *list) {
       readEntry(entry, i++, nodes, edges, metric_map, name);
     }
-    return TopologicalMap::build(name, std::move(nodes), edges, source_, metric_map);
+    std::optional<MapDatum> datum;
+    if (format == MapFormat::kTmap2) {
+      applyTransformation(root["transformation"], nodes);
+      datum = readDatum(root["meta"]);
+    }
+    TopologicalMap map = TopologicalMap::build(name, std::move(nodes), edges, source_, metric_map);
+    map.setDatum(datum);
+    return map;
   }
 
  private:
@@ -83,6 +93,49 @@ class MapReader {
     } catch (const std::logic_error&) {
       throw MapError(source_, "not a number: '" + text + "'", node, path);
     }
+  }
+
+  // tmap2 `transformation` (LCAS): node poses are in its child frame; parent <- child is the rotation
+  // (quaternion w, x, y, z) and translation given. The map returned is in the parent frame (`map` on LCAS robots).
+  void applyTransformation(const YAML::Node& t, std::vector<Node>& nodes) {
+    if (!t || t.IsNull()) return;
+    if (!t.IsMap()) throw MapError(source_, "'transformation' must be a mapping", "", "transformation");
+    Eigen::Quaterniond r = Eigen::Quaterniond::Identity();
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    if (const YAML::Node q = t["rotation"]) {
+      if (!q.IsMap()) throw MapError(source_, "expected a mapping", "", "transformation.rotation");
+      r = Eigen::Quaterniond(number(q, "w", "", "transformation.rotation.w", false, 1.0),
+                             number(q, "x", "", "transformation.rotation.x", false),
+                             number(q, "y", "", "transformation.rotation.y", false),
+                             number(q, "z", "", "transformation.rotation.z", false));
+      if (!(r.norm() > 1e-9)) throw MapError(source_, "rotation quaternion is zero", "", "transformation.rotation");
+      r.normalize();
+    }
+    if (const YAML::Node v = t["translation"]) {
+      if (!v.IsMap()) throw MapError(source_, "expected a mapping", "", "transformation.translation");
+      x = Eigen::Vector3d(number(v, "x", "", "transformation.translation.x", false),
+                          number(v, "y", "", "transformation.translation.y", false),
+                          number(v, "z", "", "transformation.translation.z", false));
+    }
+    if (r.isApprox(Eigen::Quaterniond::Identity(), 1e-12) && x.isZero(0.0)) return;
+    for (Node& n : nodes) {
+      n.position = r * n.position + x;
+      const Eigen::Quaterniond o(n.orientation[3], n.orientation[0], n.orientation[1], n.orientation[2]);
+      const Eigen::Quaterniond turned = (r * o).normalized();
+      n.orientation = {turned.x(), turned.y(), turned.z(), turned.w()};
+    }
+  }
+
+  // meta.datum_latitude / meta.datum_longitude (both or neither) and optional meta.datum_altitude.
+  std::optional<MapDatum> readDatum(const YAML::Node& meta) {
+    if (!meta || !meta.IsMap() || (!meta["datum_latitude"] && !meta["datum_longitude"])) return std::nullopt;
+    MapDatum d;
+    d.latitude = number(meta, "datum_latitude", "", "meta.datum_latitude", true);
+    d.longitude = number(meta, "datum_longitude", "", "meta.datum_longitude", true);
+    d.altitude = number(meta, "datum_altitude", "", "meta.datum_altitude", false);
+    if (std::abs(d.latitude) > 90.0 || std::abs(d.longitude) > 180.0)
+      throw MapError(source_, "datum latitude / longitude out of range", "", "meta.datum_latitude");
+    return d;
   }
 
   void readEntry(const YAML::Node& entry, std::size_t i, std::vector<Node>& nodes, std::vector<EdgeSpec>& edges,

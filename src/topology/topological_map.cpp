@@ -124,6 +124,7 @@ TopologicalMap::TopologicalMap(const TopologicalMap& other)
     : name_(other.name_),
       metric_map_(other.metric_map_),
       source_(other.source_),
+      datum_(other.datum_),
       nodes_(other.nodes_),
       edges_(other.edges_),
       index_(other.index_),

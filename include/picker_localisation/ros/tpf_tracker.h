@@ -10,7 +10,9 @@
 // Per picker: <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
 // (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
 // belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node highlighted;
-// built only while someone subscribes); services <prefix>/<id>/reset (ResetBelief) and <prefix>/<id>/what_if
+// built only while someone subscribes), <ns>/<id>/current_node (std_msgs/String, the MAP node's name, on change:
+// what LCAS coordination reads of an agent; ns ~current_node_namespace, default the prefix, "/" for
+// /<id>/current_node, "" none); services <prefix>/<id>/reset (ResetBelief) and <prefix>/<id>/what_if
 // (WhatIf, on a copy of the filter); prefix ~topic_prefix = /pickers. Each topic behaves as latched (a new
 // subscriber gets the current message at once) but costs nothing while nobody listens (LastValuePublisher).
 // Every picker's beliefs also stream on <prefix>/beliefs (PickerBeliefArray, not latched): one connection for a
@@ -39,6 +41,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
+#include <std_msgs/String.h>
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <picker_localisation/Observation.h>
@@ -101,6 +104,7 @@ class TpfTracker {
     picker_localisation::PickerBelief belief;
     std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate;
     std::optional<visualization_msgs::MarkerArray> markers;
+    std::optional<std_msgs::String> current_node;
   };
   struct Pending {
     core::Observation obs;
@@ -137,7 +141,7 @@ class TpfTracker {
 
   bool ok_ = false;
   ros::NodeHandle nh_;
-  std::string frame_id_, prefix_;
+  std::string frame_id_, prefix_, current_node_ns_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   YAML::Node base_params_;
   int seed_param_ = 0;

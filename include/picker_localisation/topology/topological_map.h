@@ -60,6 +60,15 @@ struct EdgeSpec {
   std::string action;
 };
 
+// Where the map's origin is on the Earth, when the map file says so (tmap2 meta.datum_latitude /
+// meta.datum_longitude [/ meta.datum_altitude], as LCAS topological_navigation's add_datum stores it): the map
+// frame is then the local east-north frame at that point.
+struct MapDatum {
+  double latitude = 0.0;   // deg WGS84
+  double longitude = 0.0;  // deg WGS84
+  double altitude = 0.0;   // m
+};
+
 struct BoundingBox {
   double min_x = 0.0, min_y = 0.0, max_x = 0.0, max_y = 0.0;
 };
@@ -91,6 +100,8 @@ class TopologicalMap {
   const std::string& name() const { return name_; }
   const std::string& metricMap() const { return metric_map_; }
   const std::string& source() const { return source_; }
+  const std::optional<MapDatum>& datum() const { return datum_; }
+  void setDatum(std::optional<MapDatum> datum) { datum_ = datum; }
 
   std::size_t numNodes() const { return nodes_.size(); }
   const Node& node(NodeIndex i) const { return nodes_.at(i); }
@@ -154,6 +165,7 @@ class TopologicalMap {
   void assignLanes();
 
   std::string name_, metric_map_, source_;
+  std::optional<MapDatum> datum_;
   std::vector<Node> nodes_;
   std::vector<Edge> edges_;
   std::unordered_map<std::string, NodeIndex> index_;

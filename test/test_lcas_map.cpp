@@ -1,0 +1,133 @@
+// rostest (test/lcas_map.test): the map as an LCAS robot publishes it, a std_msgs/String holding the tmap2 as
+// JSON on /topological_map_2, with meta.datum_latitude / datum_longitude and a transformation that rotates
+// the node poses by 90 degrees and shifts them by (40, -25) m. gnss_ingest has no datum file, so only the
+// map's datum can turn a picker's fix into map coordinates; the tracker must name the node where the fix puts
+// the picker on /picker_1/current_node.
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/NavSatFix.h>
+#include <std_msgs/String.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/topology/map_io.h"
+
+using namespace picker_localisation;
+
+namespace {
+
+// A YAML document as JSON (as Python's json.dumps of the loaded tmap2 would write it).
+void writeJson(const YAML::Node& n, std::ostream& out) {
+  if (n.IsMap()) {
+    out << '{';
+    bool first = true;
+    for (const auto& kv : n) {
+      out << (first ? "" : ",") << '"' << kv.first.as<std::string>() << "\":";
+      writeJson(kv.second, out);
+      first = false;
+    }
+    out << '}';
+  } else if (n.IsSequence()) {
+    out << '[';
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      if (i) out << ',';
+      writeJson(n[i], out);
+    }
+    out << ']';
+  } else if (n.IsNull()) {
+    out << "null";
+  } else {
+    const std::string s = n.Scalar();
+    char* end = nullptr;
+    std::strtod(s.c_str(), &end);
+    if (!s.empty() && end && *end == '\0') {
+      out << s;
+    } else {
+      out << '"';
+      for (char c : s) {
+        if (c == '"' || c == '\\') out << '\\';
+        out << c;
+      }
+      out << '"';
+    }
+  }
+}
+
+constexpr double kDatumLatitude = 52.1, kDatumLongitude = 1.2;  // not config/datum.yaml's
+
+}  // namespace
+
+TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
+  ros::NodeHandle nh, pnh("~");
+  std::string map_file;
+  ASSERT_TRUE(pnh.getParam("map_file", map_file));
+  YAML::Node doc = YAML::LoadFile(map_file);
+  doc["meta"]["datum_latitude"] = kDatumLatitude;
+  doc["meta"]["datum_longitude"] = kDatumLongitude;
+  doc["transformation"]["rotation"]["w"] = std::sqrt(0.5);
+  doc["transformation"]["rotation"]["x"] = 0.0;
+  doc["transformation"]["rotation"]["y"] = 0.0;
+  doc["transformation"]["rotation"]["z"] = std::sqrt(0.5);
+  doc["transformation"]["translation"]["x"] = 40.0;
+  doc["transformation"]["translation"]["y"] = -25.0;
+  std::ostringstream json;
+  writeJson(doc, json);
+  std_msgs::String text;
+  text.data = json.str();
+  ASSERT_EQ(text.data.front(), '{');
+
+  // Where the nodes are in the map frame: rotated and shifted, as the nodes must read them.
+  const topology::TopologicalMap file_map = topology::loadMap(map_file);
+  const topology::TopologicalMap lcas_map = topology::parseMap(text.data, "/topological_map_2");
+  ASSERT_EQ(lcas_map.numNodes(), file_map.numNodes());
+  ASSERT_TRUE(lcas_map.datum().has_value());
+  const topology::NodeIndex target = lcas_map.laneNodes(3)[lcas_map.laneNodes(3).size() / 2];
+  const Eigen::Vector2d p_file = file_map.position2d(target), p_map = lcas_map.position2d(target);
+  EXPECT_NEAR(p_map.x(), 40.0 - p_file.y(), 1e-6);
+  EXPECT_NEAR(p_map.y(), -25.0 + p_file.x(), 1e-6);
+  EXPECT_GT((p_map - p_file).norm(), 20.0);  // the test cannot pass with the transformation ignored
+
+  ros::Publisher map_pub = nh.advertise<std_msgs::String>("/topological_map_2", 1, /*latch=*/true);
+  map_pub.publish(text);
+  std::mutex m;
+  std::string current;
+  ros::Subscriber sub =
+      nh.subscribe<std_msgs::String>("/picker_1/current_node", 5, [&](const std_msgs::String::ConstPtr& s) {
+        std::lock_guard<std::mutex> lock(m);
+        current = s->data;
+      });
+  ros::Publisher fix_pub = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 10);
+
+  sensors::DatumConfig c;
+  c.latitude = kDatumLatitude;
+  c.longitude = kDatumLongitude;
+  const sensors::GeodeticDatum datum(c);
+  const std::string expected = lcas_map.node(target).name;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(60.0);
+  bool reached = false;
+  while (ros::ok() && ros::WallTime::now() < end && !reached) {
+    fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
+    ros::WallDuration(0.5).sleep();
+    std::lock_guard<std::mutex> lock(m);
+    reached = current == expected;
+  }
+  std::lock_guard<std::mutex> lock(m);
+  EXPECT_EQ(current, expected) << "the picker stands at " << expected << " (" << p_map.transpose()
+                               << " in the map frame)";
+}
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_lcas_map");
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  const int rc = RUN_ALL_TESTS();
+  spinner.stop();
+  return rc;
+}
