@@ -7,6 +7,8 @@
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <ros/topic.h>
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
@@ -150,6 +152,13 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
     std::lock_guard<std::mutex> lock(g_mutex);
     EXPECT_EQ(goals.at("robot_3").node, g_map->node(g_filter->belief().map_node).name);
   }
+
+  // The goal as a PoseStamped too (navigation stacks that take a pose): exactly a node's pose, map frame.
+  auto pose = ros::topic::waitForMessage<geometry_msgs::PoseStamped>("/robot_1/goal_pose", nh, ros::Duration(10.0));
+  ASSERT_TRUE(pose) << "no /robot_1/goal_pose";
+  EXPECT_EQ(pose->header.frame_id, "map");
+  const Eigen::Vector2d at(pose->pose.position.x, pose->pose.position.y);
+  EXPECT_LT((g_map->position2d(g_map->nearestNode(at)) - at).norm(), 1e-9);
 
   // get_candidates: ranked, one normalised row of 4 criteria per node, all in [0, 1].
   ros::ServiceClient client = nh.serviceClient<picker_localisation::GetCandidates>("/robot_1/get_candidates");

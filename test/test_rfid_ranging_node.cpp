@@ -85,6 +85,23 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
 }
 
 // A picker added to the tracker at run time (its list on /pickers/registry): its tag is read as its own.
+// A front-end whose input topic stays silent (a misspelt name) must not look green.
+TEST(RfidRangingNode, SilentInputGoesWarn) {
+  ros::NodeHandle nh;
+  diagnostic_msgs::DiagnosticStatus quiet;
+  ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& s : m->status)
+          if (s.name.find("robot_2") != std::string::npos && s.name.find("RFID ranging") != std::string::npos)
+            quiet = s;
+      });
+  ASSERT_TRUE(ranging_test::waitFor(
+      [&] { return quiet.level == diagnostic_msgs::DiagnosticStatus::WARN; }, 20.0))
+      << "robot_2's rfid_ranging reports '" << quiet.message << "' (level " << int(quiet.level) << ")";
+  EXPECT_NE(quiet.message.find("RFID reads: nothing for"), std::string::npos) << quiet.message;
+  EXPECT_NE(quiet.message.find("check the topic names"), std::string::npos) << quiet.message;
+}
+
 TEST(RfidRangingNode, FollowsThePickerListOfTheTracker) {
   ros::NodeHandle nh;
   ranging_test::Collector c(nh, "RFID ranging");

@@ -98,6 +98,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
   updater_.setHardwareID("gnss_ingest");
+  silence_.configure(pnh, "GNSS fixes");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
   ok_ = true;
@@ -182,6 +183,7 @@ bool GnssIngestNode::checkClock() {
 
 void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker) {
   checkClock();
+  silence_.heard();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix stamped %.3f is more than %.1f s ahead of the clock: rejected",
                       picker->config.id.c_str(), msg->header.stamp.toSec(), stamp_guard_.maxFuture());
@@ -413,6 +415,7 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu fix(es) rejected so far", rejected);
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "running");
+  if (!pickers_.empty()) silence_.report(stat);
 }
 
 }  // namespace ros_adapter

@@ -1,5 +1,6 @@
 #include "picker_localisation/ros/nbs_planner_node.h"
 
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <yaml-cpp/yaml.h>
 
@@ -106,6 +107,10 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     battery_sub_ = nh_.subscribe(battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
 
   goal_pub_ = nh_.advertise<picker_localisation::GoalNode>("goal", 1, true);
+  // The same goal for navigation stacks that take a pose (move_base_simple/goal style), latched.
+  std::string goal_pose_topic;
+  pnh_.param<std::string>("goal_pose_topic", goal_pose_topic, "goal_pose");
+  if (!goal_pose_topic.empty()) goal_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>(goal_pose_topic, 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("nbs_candidates", 1, true);
   candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
   diagnostics_.setHardwareID(robot_id_);
@@ -267,6 +272,12 @@ void NbsPlannerNode::publish(const nbs::PlanResult& plan, const ros::Time& stamp
     g.policy = nbs::toString(plan.policy);
     g.target_picker = best.target_picker;
     goal_pub_.publish(g);
+    if (goal_pose_pub_) {
+      geometry_msgs::PoseStamped p;
+      p.header = g.header;
+      p.pose = g.pose;
+      goal_pose_pub_.publish(p);
+    }
   }
   marker_pub_.publish(candidateMarkers(plan, stamp));
   ++markers_published_;

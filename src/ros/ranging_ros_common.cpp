@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "picker_localisation/ros/observation_conversions.h"
@@ -99,6 +100,33 @@ Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
   const double yaw = std::atan2(t.linear()(1, 0), t.linear()(0, 0));
   p.linear() = Eigen::Rotation2Dd(yaw).toRotationMatrix();
   return p;
+}
+
+void SilenceWatch::configure(ros::NodeHandle& pnh, std::string what) {
+  what_ = std::move(what);
+  pnh.param("silent_warn_after", warn_after_, warn_after_);
+}
+
+void SilenceWatch::heard() { last_ = ros::Time::now(); }
+
+void SilenceWatch::report(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const ros::Time now = ros::Time::now();
+  if (now.isZero()) return;          // sim clock not running yet
+  if (start_.isZero()) start_ = now;  // the first report: quiet since here
+  const ros::Time since = last_.isZero() ? start_ : last_;
+  if (now < since) {  // the clock jumped back
+    start_ = now;
+    last_ = ros::Time();
+    return;
+  }
+  const double quiet = (now - since).toSec();
+  stat.add(what_ + ": seconds since the last", last_.isZero() ? -1.0 : quiet);
+  if (warn_after_ > 0.0 && quiet > warn_after_) {
+    char text[200];
+    std::snprintf(text, sizeof(text), "%s: nothing for %.0f s%s", what_.c_str(), quiet,
+                  last_.isZero() ? " since the start (check the topic names)" : "");
+    stat.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+  }
 }
 
 }  // namespace ros_adapter

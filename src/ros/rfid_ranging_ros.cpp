@@ -35,6 +35,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::vector<std::string> topics = stringListParam(pnh, "rfid_topics", {"rfid"});
   for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
   updater_.setHardwareID("rfid_ranging");
+  silence_.configure(pnh, "RFID reads");
   updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
   registry_sub_ = followPickerList(nh, pnh, "rfid_ranging", [this](const core::PickerRegistry& r) {
@@ -45,6 +46,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
+  silence_.heard();
   if (stamp_guard_.clockJumpedBack()) {
     ROS_WARN("rfid_ranging: the clock jumped back: read histories reset");
     model_->reset();
@@ -103,6 +105,7 @@ void RfidRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no usable RFID reads yet");
   else
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu read(s) dropped or rejected", bad);
+  silence_.report(stat);
 }
 
 }  // namespace ros_adapter

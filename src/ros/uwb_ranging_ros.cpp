@@ -62,6 +62,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
   flush_timer_ = nh.createWallTimer(ros::WallDuration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
   updater_.setHardwareID("uwb_ranging");
+  silence_.configure(pnh, "UWB ranges");
   updater_.add("UWB ranging", this, &UwbRangingNode::diagnose);
   diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
   registry_sub_ = followPickerList(nh, pnh, "uwb_ranging", [this](const core::PickerRegistry& r) {
@@ -91,6 +92,7 @@ std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, 
 }
 
 void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
+  silence_.heard();
   if (stamp_guard_.clockJumpedBack()) {
     ROS_WARN("uwb_ranging: the clock jumped back: tag filters reset");
     uwb_->reset();
@@ -196,6 +198,7 @@ void UwbRangingNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no usable UWB ranges yet");
   else
     stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "running; %zu range(s) dropped or rejected", bad);
+  silence_.report(stat);
 }
 
 }  // namespace ros_adapter

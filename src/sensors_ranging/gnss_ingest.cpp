@@ -43,7 +43,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "datum_source",      "map_file",
-        "map_timeout",      "frame_id",     "observation_topic", "map_topic", "max_future_stamp",
+        "map_timeout",      "frame_id",     "observation_topic", "map_topic", "max_future_stamp", "silent_warn_after",
         "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
         "on_demand_topics_above", "demand_poll_period"};
     known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());

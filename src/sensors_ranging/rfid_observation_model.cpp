@@ -58,6 +58,7 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "map_file",
                                             "pickers_file",
                                             "map_topic",
+                                            "silent_warn_after",
                                             "max_future_stamp",
                                             "registry_topic"};
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));

@@ -88,7 +88,7 @@ class NbsPlannerNode {
   std::map<std::string, PeerGoal> peer_goals_;
   StampGuard clock_guard_;  // jump-back detection only
   ros::Subscriber battery_sub_;
-  ros::Publisher goal_pub_, marker_pub_;
+  ros::Publisher goal_pub_, goal_pose_pub_, marker_pub_;
   ros::ServiceServer candidates_srv_;
   ros::Timer timer_;
   tf2_ros::Buffer tf_buffer_;

@@ -51,6 +51,22 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
                                                  double timeout, std::string* error);
 // The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
 std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
+// A front-end's input that should be talking (a mistyped topic must not look green): once
+// ~silent_warn_after s of ROS time (default 30; 0 = never) pass without a message, since the start or since the
+// last one, the node's diagnostics go WARN naming the input and how long it has been quiet.
+class SilenceWatch {
+ public:
+  void configure(ros::NodeHandle& pnh, std::string what);
+  void heard();  // a message arrived
+  // Adds "<what>: seconds since the last" and, when silent too long, merges a WARN into the summary.
+  void report(diagnostic_updater::DiagnosticStatusWrapper& stat);
+
+ private:
+  std::string what_;
+  double warn_after_ = 30.0;
+  ros::Time start_, last_;
+};
+
 // A list-of-strings parameter; also accepts one string ("[a, b]", "a b") as rosrun _name:=... gives it.
 std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
                                          const std::vector<std::string>& fallback);
@@ -131,6 +147,7 @@ class GnssIngestNode {
   ros::Timer diag_timer_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   StampGuard stamp_guard_;
+  SilenceWatch silence_;
   OnDemandTopics on_demand_;
 };
 
@@ -158,6 +175,7 @@ class RfidRangingNode {
   ros::Timer diag_timer_;
   std::size_t tf_failures_ = 0, published_ = 0;
   StampGuard stamp_guard_;
+  SilenceWatch silence_;
 };
 
 // uwb_ranging: UwbRange (+ optional camera BearingDetectionArray) -> anchors / cameras in base_link and the
@@ -194,6 +212,7 @@ class UwbRangingNode {
   ros::Timer diag_timer_;
   std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
   StampGuard stamp_guard_;
+  SilenceWatch silence_;
   bool have_range_ = false;
   double newest_stamp_ = 0.0;     // newest accepted-or-not range stamp (s)
   ros::WallTime last_arrival_;    // wall time of the last range message
