@@ -8,4 +8,4 @@ add_test(NAME replay_deterministic
   COMMAND ${CATKIN_DEVEL_PREFIX}/env.sh ${CMAKE_CURRENT_SOURCE_DIR}/test/check_replay.sh ${CMAKE_BINARY_DIR}/replay_check)
 set_tests_properties(replay_deterministic PROPERTIES RUN_SERIAL TRUE TIMEOUT 900)
 # README.md is assembled from docs/readme/*.md: fail when someone edited one without the other.
-add_test(NAME readme_up_to_date COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/scripts/build_readme.py --check)
+add_test(NAME docs_links COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/scripts/check_docs.py)

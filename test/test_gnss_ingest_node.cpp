@@ -1,6 +1,8 @@
 // rostest: gnss_ingest through ROS. Bad fixes (NaN, NO_FIX, negative covariance, repeated and backwards
 // stamps) publish nothing and do not stop the node; good fixes before and after become identifying
 // Observations at the right place; diagnostics count the rejections.
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <sensor_msgs/NavSatFix.h>
 
@@ -152,6 +154,71 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
       5.0))
       << c.diag["picker_3 bias sightings accepted/refused"] << "; people "
       << c.diag["people received / identified / nobody's / malformed"];
+}
+
+// Issue "Drop-in on an LCAS robot": a picker position already in the map frame (PoseWithCovarianceStamped) is an
+// identifying observation; one in another frame is dropped and counted. People of another detector
+// (PoseArray, as bayes_people_tracker publishes) go through the same association as the LiDAR's.
+TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
+  namespace pl = picker_localisation;
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "GNSS ingestion");
+  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  const pl::topology::TopologicalMap map =
+      pl::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  ros::Publisher pose = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/pickers/picker_2/pose", 5);
+  ros::Publisher people = nh.advertise<geometry_msgs::PoseArray>("/people_tracker/pose_array", 5);
+  ros::Publisher fixes = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_3/fix", 20);
+  ASSERT_TRUE(ranging_test::waitFor([&] {
+    return pose.getNumSubscribers() > 0 && people.getNumSubscribers() > 0 && fixes.getNumSubscribers() > 0;
+  }, 30.0));
+  const pl::topology::NodeIndex node = map.laneNodes(2)[4];
+  geometry_msgs::PoseWithCovarianceStamped p;
+  p.header.stamp = ros::Time::now();
+  p.header.frame_id = "map";
+  p.pose.pose.position.x = map.position2d(node).x();
+  p.pose.pose.position.y = map.position2d(node).y();
+  p.pose.pose.orientation.w = 1.0;
+  p.pose.covariance[0] = p.pose.covariance[7] = 0.25;
+  pose.publish(p);
+  p.header.frame_id = "odom";  // not the map frame: dropped
+  pose.publish(p);
+  auto bySensor = [&](const std::string& sensor) {
+    const pl::Observation* found = nullptr;
+    for (const auto& o : c.obs)
+      if (o.sensor == sensor) found = &o;
+    return found;
+  };
+  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("pose") != nullptr; }, 10.0)) << "no pose observation";
+  const pl::Observation& o = *bySensor("pose");
+  EXPECT_TRUE(o.identifying);
+  EXPECT_EQ(o.picker_id, "picker_2");
+  EXPECT_NEAR(o.position.x, map.position2d(node).x(), 1e-9);
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < o.likelihood.size(); ++k)
+    if (o.likelihood[k] > o.likelihood[best]) best = k;
+  EXPECT_EQ(o.nodes.at(best), map.node(node).name);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["picker poses published / dropped"] == "1 / 1"; }, 5.0))
+      << c.diag["picker poses published / dropped"];
+
+  // picker_3's unit reads (3, 2) m off and its bias is known from the test before: a person of the other
+  // detector where picker_3 really is names picker_3; one far from everybody is nobody's.
+  const Eigen::Vector2d truth(15.0, -2.0), offset(3.0, 2.0);
+  const ros::Time t = ros::Time::now();
+  fixes.publish(fixAt(datum, truth + offset, t));
+  ranging_test::spinFor(0.3);
+  geometry_msgs::PoseArray a;
+  a.header.stamp = t + ros::Duration(0.1);
+  a.header.frame_id = "map";
+  a.poses.resize(2);
+  a.poses[0].position.x = truth.x();
+  a.poses[0].position.y = truth.y();
+  a.poses[1].position.x = 300.0;
+  a.poses[1].position.y = 300.0;
+  people.publish(a);
+  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("people") != nullptr; }, 10.0)) << "no people observation";
+  EXPECT_TRUE(bySensor("people")->identifying);
+  EXPECT_EQ(bySensor("people")->picker_id, "picker_3");
 }
 
 // Issue "Track a whole farm": gnss_ingest follows the tracker's picker list (/pickers/registry): a picker

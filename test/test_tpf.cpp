@@ -651,7 +651,9 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.prediction_rate, 0.25);
   EXPECT_EQ(p.motion_model, tpf::MotionModel::kVelocity);
   EXPECT_TRUE(p.jsd_monitor);
-  EXPECT_EQ(p.reinit_sensors, (std::vector<std::string>{"gnss", "uwb"}));  // measured default (tpf.md)
+  EXPECT_EQ(p.reinit_sensors, (std::vector<std::string>{"gnss", "uwb", "pose"}));  // measured default (tpf.md); pose: map-frame positions, as GNSS
+  EXPECT_EQ(p.gammaFor("pose").node, 1.0);
+  EXPECT_EQ(p.gammaFor("people").node, 0.25);
   EXPECT_TRUE(p.entropy_gate);
   EXPECT_FALSE(p.directed_motion);
   EXPECT_TRUE(p.accepted_sensors.empty());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <sstream>
 
 #include <ros/names.h>
@@ -88,6 +89,20 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
     ROS_INFO("gnss_ingest: %s anonymous people from %s", o.association.enabled ? "associating" : "passing on",
              person_topic.c_str());
   }
+  // Other people detectors and map-frame picker positions (issue "Drop-in on an LCAS robot").
+  pnh.param<std::string>("people_pose_sensor", people_pose_sensor_, people_pose_sensor_);
+  pnh.param("people_pose_sigma", people_pose_sigma_, people_pose_sigma_);
+  pnh.param<std::string>("pose_sensor", pose_sensor_, pose_sensor_);
+  pnh.param<std::string>("pose_topic_format", pose_topic_format_, "");
+  if (!(people_pose_sigma_ > 0.0) || !std::isfinite(people_pose_sigma_) || people_pose_sensor_.empty() ||
+      pose_sensor_.empty()) {
+    ROS_FATAL("gnss_ingest: people_pose_sigma must be > 0 and people_pose_sensor / pose_sensor non-empty");
+    return;
+  }
+  for (const std::string& t : stringListParam(pnh, "people_pose_topics", {}))
+    subs_.push_back(nh.subscribe<geometry_msgs::PoseArray>(
+        t, 20, [this, t](const geometry_msgs::PoseArray::ConstPtr& m) { onPeoplePoses(m, t); }));
+  followPoseTopics(registry.ids());
   if (!o.bias.sighting_sensors.empty())
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onIdentified(m); }));
@@ -149,6 +164,7 @@ void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
       ++added;
     }
   if (beliefs_) beliefs_->follow(order);
+  followPoseTopics(order);
   if (added + removed > 0)
     ROS_INFO("gnss_ingest: picker list from the tracker: %zu added, %zu removed, %zu with GNSS", added, removed,
              pickers_.size());
@@ -222,14 +238,22 @@ void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& 
     ++published_;
     return;
   }
-  if (ordering_latency_ <= 0.0) {
-    processPerson(in.person);
-    return;
-  }
   std::ostringstream key;
   key.precision(17);
   key << "person|" << msg->robot_id << "|" << msg->position.x << "|" << msg->position.y;
-  ordering_.push(in.person.stamp, key.str(), std::move(in));
+  acceptPerson(std::move(in.person), key.str());
+}
+
+void GnssIngestNode::acceptPerson(core::Observation person, const std::string& key) {
+  if (ordering_latency_ <= 0.0) {
+    processPerson(person);
+    return;
+  }
+  Input in;
+  in.is_fix = false;
+  in.person = std::move(person);
+  const double stamp = in.person.stamp;
+  ordering_.push(stamp, key, std::move(in));
 }
 
 void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
@@ -275,6 +299,86 @@ void GnssIngestNode::releaseOrdered() {
       processPerson(item.second.person);
     }
   }
+}
+
+bool GnssIngestNode::inMapFrame(const std::string& frame, const char* what) {
+  if (frame.empty() || frame == frame_id_ || frame == "/" + frame_id_) return true;
+  ++bad_poses_;
+  ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s in frame '%s' dropped: positions must be in the map frame '%s'", what,
+                    frame.c_str(), frame_id_.c_str());
+  return false;
+}
+
+void GnssIngestNode::onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg, const std::string& topic) {
+  checkClock();
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp) || !inMapFrame(msg->header.frame_id, "people poses")) return;
+  std::size_t k = 0;
+  for (const auto& pose : msg->poses) {
+    const Eigen::Vector2d at(pose.position.x, pose.position.y);
+    if (!at.allFinite()) {
+      ++bad_people_;
+      continue;
+    }
+    core::Observation person;  // anonymous, as a leg_detector's person
+    person.stamp = msg->header.stamp.toSec();
+    person.sensor = people_pose_sensor_;
+    person.position = at;
+    person.position_covariance = Eigen::Matrix2d::Identity() * people_pose_sigma_ * people_pose_sigma_;
+    core::setGaussianLikelihood(person, *map_, at, person.position_covariance);
+    if (person.empty()) {
+      ++bad_people_;  // off the map
+      continue;
+    }
+    acceptPerson(std::move(person), topic + "|" + std::to_string(k++));
+  }
+}
+
+void GnssIngestNode::followPoseTopics(const std::vector<std::string>& ids) {
+  if (pose_topic_format_.empty()) return;
+  const std::set<std::string> wanted(ids.begin(), ids.end());
+  for (auto it = pose_subs_.begin(); it != pose_subs_.end();)
+    it = wanted.count(it->first) ? std::next(it) : pose_subs_.erase(it);
+  for (const std::string& id : wanted) {
+    if (pose_subs_.count(id)) continue;
+    std::string topic = pose_topic_format_;
+    for (std::size_t at = topic.find("{id}"); at != std::string::npos; at = topic.find("{id}"))
+      topic.replace(at, 4, id);
+    pose_subs_[id] = nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+        topic, 20, [this, id](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { onPickerPose(m, id); });
+  }
+}
+
+void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg,
+                                  const std::string& picker) {
+  checkClock();
+  if (stamp_guard_.tooFarInFuture(msg->header.stamp) || !inMapFrame(msg->header.frame_id, "picker pose")) return;
+  const auto& c = msg->pose.covariance;  // row-major 6x6 (x, y, z, rotations): the x-y block
+  Eigen::Matrix2d cov;
+  cov << c[0], c[1], c[6], c[7];
+  const Eigen::Vector2d at(msg->pose.pose.position.x, msg->pose.pose.position.y);
+  cov = 0.5 * (cov + cov.transpose());
+  if (!at.allFinite() || !cov.allFinite() || cov(0, 0) < 0.0 || cov(1, 1) < 0.0 || cov.determinant() < -1e-9) {
+    ++bad_poses_;
+    ROS_WARN_THROTTLE(5.0, "gnss_ingest: pose of %s dropped: position or covariance not finite / not PSD",
+                      picker.c_str());
+    return;
+  }
+  core::Observation obs;
+  obs.stamp = msg->header.stamp.toSec();
+  obs.sensor = pose_sensor_;
+  obs.picker_id = picker;
+  obs.identifying = true;
+  obs.position = at;
+  obs.position_covariance = cov;
+  core::GaussianLikelihoodOptions lo = options_.likelihoodOptions();
+  core::setGaussianLikelihood(obs, *map_, at, cov, lo);
+  if (obs.empty()) {
+    ++bad_poses_;
+    return;
+  }
+  pub_.publish(toMsg(obs, *map_, frame_id_));
+  ++published_;
+  ++picker_poses_;
 }
 
 void GnssIngestNode::processFix(Picker& picker, const sensors::GnssFix& fix) {
@@ -398,6 +502,7 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("people received / identified / nobody's / malformed",
            std::to_string(people_) + " / " + std::to_string(identified_) + " / " + std::to_string(nobody_) + " / " +
                std::to_string(bad_people_));
+  stat.add("picker poses published / dropped", std::to_string(picker_poses_) + " / " + std::to_string(bad_poses_));
   stat.add("waiting for stamp order", ordering_.size());
   stat.add("ordering latency (s)", ordering_latency_);
   stat.add("pickers with GNSS", pickers_.size());

@@ -44,6 +44,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "pickers_file", "datum_file",        "datum_source",      "map_file",
         "map_timeout",      "frame_id",     "observation_topic", "map_topic", "max_future_stamp", "silent_warn_after",
+        "people_pose_topics", "people_pose_sensor", "people_pose_sigma", "pose_topic_format", "pose_sensor",
         "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
         "on_demand_topics_above", "demand_poll_period"};
     known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
@@ -250,10 +251,7 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   obs.sensor = options_.sensor;
   obs.picker_id = picker_id_;
   obs.identifying = true;
-  core::GaussianLikelihoodOptions lo;
-  lo.cutoff_sigmas = options_.cutoff_sigmas;
-  lo.min_sigma = options_.min_sigma;
-  lo.max_nodes = options_.max_nodes;
+  core::GaussianLikelihoodOptions lo = options_.likelihoodOptions();
   if (bias_.usable(fix.stamp)) {
     // Bias removed (seed 001 Sec. VI): the fix minus the estimate, with the estimate's own uncertainty in
     // place of the unit's reported one (which is mostly the bias itself).

@@ -18,7 +18,11 @@ TpfParams::TpfParams() {
   // Not in the paper: UWB identifies like RFID; a camera is anonymous like LiDAR.
   sensor_gammas["uwb"] = SensorGamma{1.0, 0.0};
   sensor_gammas["camera"] = SensorGamma{0.25, 0.0};
-  reinit_sensors = {"gnss", "uwb"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
+  // Not in the paper: map-frame picker positions (gnss_ingest ~pose_topic_format, e.g. a phone app's server),
+  // trusted as GNSS; other people detectors' anonymous poses (~people_pose_topics) as LiDAR.
+  sensor_gammas["pose"] = SensorGamma{1.0, 0.0};
+  sensor_gammas["people"] = SensorGamma{0.25, 0.0};
+  reinit_sensors = {"gnss", "uwb", "pose"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
 }
 
 SensorGamma TpfParams::gammaFor(const std::string& sensor) const {

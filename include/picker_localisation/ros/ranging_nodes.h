@@ -4,6 +4,8 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <picker_localisation/BearingDetectionArray.h>
 #include <picker_localisation/GnssBias.h>
 #include <picker_localisation/Observation.h>
@@ -117,6 +119,15 @@ class GnssIngestNode {
   void onRegistry(const core::PickerRegistry& registry);
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
   void onPerson(const picker_localisation::Observation::ConstPtr& msg);
+  // Anonymous people of other detectors (geometry_msgs/PoseArray in the map frame, as bayes_people_tracker
+  // publishes) and picker positions already in the map frame (PoseWithCovarianceStamped per picker, e.g. from a
+  // phone app's server): observations like any other sensor's.
+  void onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg, const std::string& topic);
+  void onPickerPose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg, const std::string& picker);
+  void followPoseTopics(const std::vector<std::string>& ids);
+  // A person observation (ours or converted) into the association, in stamp order when ordering.
+  void acceptPerson(core::Observation person, const std::string& key);
+  bool inMapFrame(const std::string& frame, const char* what);
   void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
   void onBelief(const picker_localisation::PickerBelief& msg);
   bool checkClock();
@@ -146,6 +157,10 @@ class GnssIngestNode {
   diagnostic_updater::Updater updater_;
   ros::Timer diag_timer_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
+  std::size_t picker_poses_ = 0, bad_poses_ = 0;
+  std::string people_pose_sensor_ = "people", pose_sensor_ = "pose", pose_topic_format_;
+  double people_pose_sigma_ = 0.3;
+  std::map<std::string, ros::Subscriber> pose_subs_;  // picker id -> its PoseWithCovarianceStamped topic
   StampGuard stamp_guard_;
   SilenceWatch silence_;
   OnDemandTopics on_demand_;

@@ -91,6 +91,14 @@ struct GnssIngestOptions {
   static GnssIngestOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static GnssIngestOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
   std::string validate() const;  // "" or "<key> = <value>: must be ..."
+  // cutoff_sigmas, min_sigma, max_nodes as core::setGaussianLikelihood takes them.
+  core::GaussianLikelihoodOptions likelihoodOptions() const {
+    core::GaussianLikelihoodOptions lo;
+    lo.cutoff_sigmas = cutoff_sigmas;
+    lo.min_sigma = min_sigma;
+    lo.max_nodes = max_nodes;
+    return lo;
+  }
 };
 
 // Result of one fix.

@@ -108,7 +108,7 @@ struct TpfParams {
   double reinit_max_mean_likelihood = 0.1;
   // Share of the particles drawn again from the observation on a re-initialisation, (0, 1]; 1 = Alg. 1 (all).
   double reinit_fraction = 1.0;
-  // Sensors whose identifying observations may re-initialise; empty = all (paper). Default {gnss, uwb}:
+  // Sensors whose identifying observations may re-initialise; empty = all (paper). Default {gnss, uwb, pose}:
   // measured (docs/readme/tpf.md), re-initialising from RFID reads 5-8 m away scatters a right belief over
   // several lanes (white-noise GNSS, rfid_gnss right-lane share 0.81 with RFID re-initialisations, 0.92
   // without; 0.89 when only 10 % of the particles are redrawn, reinit_fraction 0.1).
