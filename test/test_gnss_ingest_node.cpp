@@ -21,10 +21,21 @@ using picker_localisation::sensors::GeodeticDatum;
 
 using ranging_test::fixAt;
 
+namespace {
+// The files the launch file gives the node.
+GeodeticDatum shippedDatum() { return GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml"); }
+picker_localisation::topology::TopologicalMap shippedMap() {
+  return picker_localisation::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+}
+// Where picker_3 stands, and how far off its unit reads (3.6 m): the people test teaches gnss_ingest this offset,
+// and the PoseArray test relies on it.
+const Eigen::Vector2d kPicker3Truth(15.0, -2.0), kPicker3Offset(3.0, 2.0);
+}  // namespace
+
 TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   ros::NodeHandle nh;
   ranging_test::Collector c(nh, "GNSS ingestion");
-  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  const GeodeticDatum datum = shippedDatum();
   ros::Publisher p1 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 20);
   ros::Publisher p2 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_2/fix", 20);
   ASSERT_TRUE(ranging_test::waitFor([&] {
@@ -87,9 +98,8 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
   namespace pl = picker_localisation;
   ros::NodeHandle nh;
   ranging_test::Collector c(nh, "GNSS ingestion");
-  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
-  const pl::topology::TopologicalMap map =
-      pl::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  const GeodeticDatum datum = shippedDatum();
+  const pl::topology::TopologicalMap map = shippedMap();
   std::vector<pl::GnssBias> bias;
   ros::Subscriber bias_sub = nh.subscribe<pl::GnssBias>(
       "/pickers/picker_3/gnss_bias", 20, [&](const pl::GnssBias::ConstPtr& m) { bias.push_back(*m); });
@@ -98,7 +108,7 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
   ASSERT_TRUE(ranging_test::waitFor([&] {
     return fixes.getNumSubscribers() > 0 && people.getNumSubscribers() > 0 && bias_sub.getNumPublishers() > 0;
   }, 30.0));
-  const Eigen::Vector2d truth(15.0, -2.0), offset(3.0, 2.0);  // picker_3's unit reads 3.6 m off
+  const Eigen::Vector2d truth = kPicker3Truth, offset = kPicker3Offset;
   auto person = [&](const Eigen::Vector2d& at, const ros::Time& stamp) {
     pl::core::Observation o;
     o.stamp = stamp.toSec();
@@ -163,9 +173,8 @@ TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
   namespace pl = picker_localisation;
   ros::NodeHandle nh;
   ranging_test::Collector c(nh, "GNSS ingestion");
-  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
-  const pl::topology::TopologicalMap map =
-      pl::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
+  const GeodeticDatum datum = shippedDatum();
+  const pl::topology::TopologicalMap map = shippedMap();
   ros::Publisher pose = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/pickers/picker_2/pose", 5);
   ros::Publisher people = nh.advertise<geometry_msgs::PoseArray>("/people_tracker/pose_array", 5);
   ros::Publisher fixes = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_3/fix", 20);
@@ -203,7 +212,7 @@ TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
 
   // picker_3's unit reads (3, 2) m off and its bias is known from the test before: a person of the other
   // detector where picker_3 really is names picker_3; one far from everybody is nobody's.
-  const Eigen::Vector2d truth(15.0, -2.0), offset(3.0, 2.0);
+  const Eigen::Vector2d truth = kPicker3Truth, offset = kPicker3Offset;
   const ros::Time t = ros::Time::now();
   fixes.publish(fixAt(datum, truth + offset, t));
   ranging_test::spinFor(0.3);
@@ -227,7 +236,7 @@ TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
   namespace pl = picker_localisation;
   ros::NodeHandle nh;
   ranging_test::Collector c(nh, "GNSS ingestion");
-  const GeodeticDatum datum = GeodeticDatum::load(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
+  const GeodeticDatum datum = shippedDatum();
   ros::Publisher registry = nh.advertise<pl::PickerList>("/pickers/registry", 1, true);
   ros::Publisher fix4 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_4/fix", 20);
   ros::Publisher fix1 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 20);

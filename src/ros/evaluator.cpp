@@ -66,16 +66,15 @@ void Evaluator::onBelief(const picker_localisation::PickerBelief& belief) {
   const auto found = index_.find(belief.picker_id);
   if (found == index_.end()) return;  // a picker this evaluation does not score
   Picker& p = pickers_[found->second];
-  const picker_localisation::PickerBelief* msg = &belief;
   ++p.beliefs;
-  if (msg->estimated_node.empty()) return;  // not initialised yet
-  if (!map_->index(msg->estimated_node)) {
+  if (belief.estimated_node.empty()) return;  // not initialised yet
+  if (!map_->index(belief.estimated_node)) {
     ++p.unknown_nodes;
     ROS_WARN_THROTTLE(5.0, "evaluator: belief of %s names unknown node '%s' (ignored)", p.id.c_str(),
-                      msg->estimated_node.c_str());
+                      belief.estimated_node.c_str());
     return;
   }
-  p.belief_history.emplace_back(msg->header.stamp.toSec(), msg->estimated_node);
+  p.belief_history.emplace_back(belief.header.stamp.toSec(), belief.estimated_node);
 }
 
 void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg) {

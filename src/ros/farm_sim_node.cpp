@@ -130,12 +130,17 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
 
   map_ = obtainMap(nh_, pnh_);
   if (!map_) return;
-  if (map_->datum() && datum_source != "file") {  // as gnss_ingest (~datum_source auto): the map's own datum wins
-    config.datum.latitude = map_->datum()->latitude;
-    config.datum.longitude = map_->datum()->longitude;
-    config.datum.altitude = map_->datum()->altitude;
-    config.datum.heading_deg = 0.0;
-    ROS_INFO("farm_sim: fixes use the map's datum (%.7f, %.7f)", config.datum.latitude, config.datum.longitude);
+  try {
+    if (useMapDatum(datum_source, *map_)) {  // the rule gnss_ingest follows, so both use one datum
+      config.datum.latitude = map_->datum()->latitude;
+      config.datum.longitude = map_->datum()->longitude;
+      config.datum.altitude = map_->datum()->altitude;
+      config.datum.heading_deg = 0.0;
+      ROS_INFO("farm_sim: fixes use the map's datum (%.7f, %.7f)", config.datum.latitude, config.datum.longitude);
+    }
+  } catch (const std::exception& e) {
+    ROS_FATAL("farm_sim: %s", e.what());
+    return;
   }
   try {
     sim_ = std::make_unique<sim::FarmSimulator>(*map_, config);

@@ -46,16 +46,22 @@ FleetBeliefs::FleetBeliefs(ros::NodeHandle& nh, ros::NodeHandle& pnh, Callback o
       });
 }
 
+void followIds(std::map<std::string, ros::Subscriber>& subscriptions, const std::vector<std::string>& ids,
+               const std::function<ros::Subscriber(const std::string& id)>& subscribe) {
+  const std::set<std::string> wanted(ids.begin(), ids.end());
+  for (auto it = subscriptions.begin(); it != subscriptions.end();)
+    it = wanted.count(it->first) ? std::next(it) : subscriptions.erase(it);
+  for (const std::string& id : wanted)
+    if (!subscriptions.count(id)) subscriptions[id] = subscribe(id);
+}
+
 void FleetBeliefs::follow(const std::vector<std::string>& ids) {
   if (!perPicker()) return;
-  const std::set<std::string> wanted(ids.begin(), ids.end());
-  for (auto it = per_picker_.begin(); it != per_picker_.end();)
-    it = wanted.count(it->first) ? std::next(it) : per_picker_.erase(it);
-  for (const std::string& id : wanted)
-    if (!per_picker_.count(id))
-      per_picker_[id] = nh_.subscribe<picker_localisation::PickerBelief>(
-          "/pickers/" + id + "/belief", 5,
-          [this](const picker_localisation::PickerBelief::ConstPtr& m) { on_belief_(*m); });
+  followIds(per_picker_, ids, [this](const std::string& id) {
+    return nh_.subscribe<picker_localisation::PickerBelief>(
+        "/pickers/" + id + "/belief", 5,
+        [this](const picker_localisation::PickerBelief::ConstPtr& m) { on_belief_(*m); });
+  });
 }
 
 }  // namespace ros_adapter

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <set>
 #include <sstream>
 
 #include <ros/names.h>
@@ -26,10 +25,6 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   std::string datum_file, datum_source;
   pnh.param<std::string>("datum_file", datum_file, "");
   pnh.param<std::string>("datum_source", datum_source, "auto");
-  if (datum_source != "auto" && datum_source != "file" && datum_source != "map") {
-    ROS_FATAL("gnss_ingest: ~datum_source '%s' must be auto, file or map", datum_source.c_str());
-    return;
-  }
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
   sensors::GnssIngestOptions o;
   if (!loadOptions(pnh, o)) return;
@@ -42,8 +37,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   // The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
   // when the map has none.
   try {
-    if (datum_source == "map" || (datum_source == "auto" && map_->datum())) {
-      if (!map_->datum()) throw std::runtime_error("~datum_source is map but the map has no meta.datum_latitude");
+    if (useMapDatum(datum_source, *map_)) {
       sensors::DatumConfig c;
       c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
       c.latitude = map_->datum()->latitude;
@@ -335,17 +329,13 @@ void GnssIngestNode::onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg
 
 void GnssIngestNode::followPoseTopics(const std::vector<std::string>& ids) {
   if (pose_topic_format_.empty()) return;
-  const std::set<std::string> wanted(ids.begin(), ids.end());
-  for (auto it = pose_subs_.begin(); it != pose_subs_.end();)
-    it = wanted.count(it->first) ? std::next(it) : pose_subs_.erase(it);
-  for (const std::string& id : wanted) {
-    if (pose_subs_.count(id)) continue;
+  followIds(pose_subs_, ids, [this](const std::string& id) {
     std::string topic = pose_topic_format_;
     for (std::size_t at = topic.find("{id}"); at != std::string::npos; at = topic.find("{id}"))
       topic.replace(at, 4, id);
-    pose_subs_[id] = nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+    return nh_.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
         topic, 20, [this, id](const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& m) { onPickerPose(m, id); });
-  }
+  });
 }
 
 void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped::ConstPtr& msg,

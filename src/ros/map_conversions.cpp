@@ -75,14 +75,9 @@ topology::TopologicalMap fromMsg(const picker_localisation::TopologicalMap& msg)
   }
   topology::TopologicalMap map = topology::TopologicalMap::build(
       msg.name, std::move(nodes), edges, msg.source_file.empty() ? "<message>" : msg.source_file, msg.metric_map);
-  if (msg.has_datum) {
-    if (!std::isfinite(msg.datum_latitude) || !std::isfinite(msg.datum_longitude) ||
-        std::abs(msg.datum_latitude) > 90.0 || std::abs(msg.datum_longitude) > 180.0)
-      throw topology::MapError(msg.source_file.empty() ? "<message>" : msg.source_file,
-                               "datum latitude / longitude not finite or out of range", "", "datum");
+  if (msg.has_datum)  // setDatum throws MapError on a bad latitude / longitude
     map.setDatum(topology::MapDatum{msg.datum_latitude, msg.datum_longitude,
                                     std::isfinite(msg.datum_altitude) ? msg.datum_altitude : 0.0});
-  }
   return map;
 }
 

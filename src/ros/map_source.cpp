@@ -4,6 +4,8 @@
 #include <ros/topic.h>
 #include <std_msgs/String.h>
 
+#include <stdexcept>
+
 #include "picker_localisation/ros/map_conversions.h"
 #include "picker_localisation/topology/map_io.h"
 
@@ -14,6 +16,14 @@ std::string mapTopic(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   std::string topic;
   if (!pnh.getParam("map_topic", topic) || topic.empty()) nh.getParam("/map_topic", topic);
   return nh.resolveName(topic.empty() ? std::string(kMapTopic) : topic);
+}
+
+bool useMapDatum(const std::string& datum_source, const topology::TopologicalMap& map) {
+  if (datum_source != "auto" && datum_source != "file" && datum_source != "map")
+    throw std::runtime_error("~datum_source '" + datum_source + "' must be auto, file or map");
+  if (datum_source == "map" && !map.datum())
+    throw std::runtime_error("~datum_source is map but the map has no meta.datum_latitude");
+  return datum_source == "map" || (datum_source == "auto" && map.datum());
 }
 
 namespace {

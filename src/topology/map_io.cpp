@@ -133,9 +133,7 @@ class MapReader {
     d.latitude = number(meta, "datum_latitude", "", "meta.datum_latitude", true);
     d.longitude = number(meta, "datum_longitude", "", "meta.datum_longitude", true);
     d.altitude = number(meta, "datum_altitude", "", "meta.datum_altitude", false);
-    if (std::abs(d.latitude) > 90.0 || std::abs(d.longitude) > 180.0)
-      throw MapError(source_, "datum latitude / longitude out of range", "", "meta.datum_latitude");
-    return d;
+    return d;  // the range is checked by TopologicalMap::setDatum
   }
 
   void readEntry(const YAML::Node& entry, std::size_t i, std::vector<Node>& nodes, std::vector<EdgeSpec>& edges,

@@ -149,6 +149,14 @@ TopologicalMap& TopologicalMap::operator=(const TopologicalMap& other) {
   return *this;
 }
 
+void TopologicalMap::setDatum(std::optional<MapDatum> datum) {
+  if (datum && (!std::isfinite(datum->latitude) || !std::isfinite(datum->longitude) ||
+                !std::isfinite(datum->altitude) || std::abs(datum->latitude) > 90.0 ||
+                std::abs(datum->longitude) > 180.0))
+    throw MapError(source_, "datum latitude / longitude not finite or out of range", "", "meta.datum_latitude");
+  datum_ = datum;
+}
+
 TopologicalMap TopologicalMap::build(std::string name, std::vector<Node> nodes, const std::vector<EdgeSpec>& edges,
                                      const std::string& source, std::string metric_map) {
   TopologicalMap map;

@@ -23,6 +23,11 @@ namespace ros_adapter {
 ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
                                  std::function<void(const core::PickerRegistry&)> apply);
 
+// Keeps one subscription per picker id: drops those of ids not in `ids`, makes the missing ones with
+// `subscribe(id)`. For per-picker input topics that follow the tracker's list.
+void followIds(std::map<std::string, ros::Subscriber>& subscriptions, const std::vector<std::string>& ids,
+               const std::function<ros::Subscriber(const std::string& id)>& subscribe);
+
 // The trackers' beliefs. ~belief_topic (default /pickers/beliefs) is tpf_tracker's fleet stream
 // (PickerBeliefArray): one connection whatever the number of pickers. ~belief_topic "" reads each picker's
 // own latched /pickers/<id>/belief instead (trackers of another package, or a consumer started long after a

@@ -26,6 +26,11 @@ constexpr const char* kMapTopic = "/picker_localisation/topological_map";
 std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, ros::NodeHandle& pnh,
                                                           double timeout = 30.0);
 
+// ~datum_source (auto | file | map) of the nodes that turn WGS84 into map coordinates (gnss_ingest, farm_sim):
+// true when the map's own datum (tmap2 meta.datum_*) is to be used: `map`, or `auto` and the map has one.
+// Throws std::runtime_error on another value, or `map` for a map without a datum.
+bool useMapDatum(const std::string& datum_source, const topology::TopologicalMap& map);
+
 // The map topic obtainMap() reads (~map_topic, /map_topic or kMapTopic), resolved.
 std::string mapTopic(ros::NodeHandle& nh, ros::NodeHandle& pnh);
 

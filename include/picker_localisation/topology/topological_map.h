@@ -101,7 +101,9 @@ class TopologicalMap {
   const std::string& metricMap() const { return metric_map_; }
   const std::string& source() const { return source_; }
   const std::optional<MapDatum>& datum() const { return datum_; }
-  void setDatum(std::optional<MapDatum> datum) { datum_ = datum; }
+  // Throws MapError (file = source(), field meta.datum_latitude) on a latitude / longitude that is not finite
+  // or out of range, or a non-finite altitude; the map is unchanged then.
+  void setDatum(std::optional<MapDatum> datum);
 
   std::size_t numNodes() const { return nodes_.size(); }
   const Node& node(NodeIndex i) const { return nodes_.at(i); }
