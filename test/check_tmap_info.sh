@@ -34,4 +34,16 @@ for f in missing_target bad_number empty scalar nonexistent; do
 done
 printf '%s\n' "$("$bin" "$tmp/missing_target.tmap2" 2>&1)" | grep -q "node 'A'" || { echo "FAIL: node name missing"; fail=1; }
 printf '%s\n' "$("$bin" "$tmp/bad_number.tmap2" 2>&1)" | grep -q "node.pose.position.x" || { echo "FAIL: field missing"; fail=1; }
+# Issue 17: a device never ends (tmap_info /dev/zero hung), a directory is no map, a 2 MB token must not be echoed.
+python3 -c "print('nodes:\n- node: {name: A, pose: {position: {x: ' + 'x' * 2000000 + ', y: 0}}}')" > "$tmp/long_token.tmap2"
+mkdir -p "$tmp/a_directory"
+for f in /dev/zero "$tmp/a_directory" "$tmp/long_token.tmap2"; do
+  out="$(timeout 20 "$bin" "$f" 2>&1 >/dev/null)"; rc=$?
+  lines="$(printf '%s\n' "$out" | grep -c .)"
+  if [ $rc -ne 2 ] || [ "$lines" -ne 1 ] || [ "${#out}" -gt 1000 ]; then
+    echo "FAIL: $f: rc=$rc lines=$lines length=${#out} out='${out:0:300}'"; fail=1
+  else
+    echo "ok: $f -> rc 2: $out"
+  fi
+done
 exit $fail

@@ -61,6 +61,8 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   send(p1, fixAt(datum, where, t0));                                        // repeated stamp
   send(p1, fixAt(datum, where, t0 - ros::Duration(1.0)));                   // backwards
   send(p1, fixAt(datum, where, ros::Time(4102444800.0)));                   // 2100-01-01: far future, dropped
+  for (int k = 1; k <= 5; ++k)  // five fixes 50 km away: off the map, neither snapped nor re-anchoring the gate
+    send(p1, fixAt(datum, where + Eigen::Vector2d(50000.0, 0.0), t0 + ros::Duration(0.1 * k)));
   send(p1, fixAt(datum, where + Eigen::Vector2d(0.5, 0.0), t0 + ros::Duration(1.0)));  // good again
   send(p2, fixAt(datum, Eigen::Vector2d(25.0, -30.0), t0 + ros::Duration(1.0)));       // other picker
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 3; }, 10.0));
@@ -80,14 +82,14 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   EXPECT_NEAR(c.obs[1].position.x, 20.5, 1e-3);
   EXPECT_TRUE(c.obs[1].has_velocity);  // two fixes: 0.5 m in 1 s
   EXPECT_NEAR(c.obs[1].velocity.x, 0.5, 1e-3);
-  // Diagnostics: rejections by kind (no_fix/not_finite/negative_cov/out_of_order/jump).
+  // Diagnostics: rejections by kind (no_fix/not_finite/negative_cov/out_of_order/jump/off_map).
   ASSERT_TRUE(ranging_test::waitFor(
       [&] {
-        return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"] == "1/1/1/2/0" &&
+        return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"] == "1/1/1/2/0/5" &&
                c.diag["picker_1 accepted"] == "2";
       },
       5.0))
-      << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump"];
+      << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"];
   EXPECT_EQ(c.diag["picker_1 accepted"], "2");  // the fix after the 2100 one was accepted: nothing blocked
   EXPECT_EQ(c.diag["fixes stamped in the future (rejected)"], "1");
 }

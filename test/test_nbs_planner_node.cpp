@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
 #include <diagnostic_msgs/DiagnosticArray.h>
@@ -221,6 +222,52 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
       << g_diagnostics.at("robot_4").message;
 }
 
+// Issue 17: when the robot's localisation stops, tf keeps serving the last pose. robot_5 (max_pose_age 1 s)
+// plans while its pose is fresh, then stops planning and says why instead of sending the robot from where it was.
+TEST(NbsPlannerNode, StaleRobotPoseStopsPlanning) {
+  ros::NodeHandle nh;
+  ros::Subscriber goals = nh.subscribe("/robot_5/goal", 5, goalCallback);
+  ros::Subscriber diagnostics = nh.subscribe("/diagnostics", 20, diagnosticsCallback);
+  tf2_ros::TransformBroadcaster tf;
+  auto sendPose = [&] {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = "map";
+    t.child_frame_id = "robot_5/base_link";
+    t.transform.translation.x = g_map->node(g_robot_node).position.x();
+    t.transform.translation.y = g_map->node(g_robot_node).position.y();
+    t.transform.rotation.w = 1.0;
+    tf.sendTransform(t);
+  };
+  ASSERT_TRUE(waitFor(
+      [&] {
+        sendPose();
+        ros::WallDuration(0.1).sleep();
+        std::lock_guard<std::mutex> lock(g_mutex);
+        return g_goals.count("robot_5") > 0;
+      },
+      30.0))
+      << "robot_5 never planned with a fresh pose";
+  const ros::Time stopped = ros::Time::now();  // the localisation stops here
+  ASSERT_TRUE(waitFor(
+      [] {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        auto it = g_diagnostics.find("robot_5");
+        return it != g_diagnostics.end() && it->second.message.find("s old") != std::string::npos;
+      },
+      15.0))
+      << "robot_5 never reported its stale pose";
+  ros::WallDuration(2.5).sleep();  // more than two planning periods after the report
+  std::lock_guard<std::mutex> lock(g_mutex);
+  EXPECT_LT(g_goals.at("robot_5").header.stamp.toSec(), stopped.toSec() + 1.5)
+      << "robot_5 kept planning from a stale pose";
+  EXPECT_EQ(g_diagnostics.at("robot_5").level, diagnostic_msgs::DiagnosticStatus::WARN);
+  bool counted = false;
+  for (const auto& kv : g_diagnostics.at("robot_5").values)
+    if (kv.key == "stale robot poses") counted = kv.value != "0";
+  EXPECT_TRUE(counted);
+}
+
 // The planner may only read beliefs, goals, the battery, tf and the clock: never a ground-truth topic.
 TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
   XmlRpc::XmlRpcValue args, result, payload;
@@ -252,7 +299,7 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }
   }
-  EXPECT_EQ(planners, 4u);
+  EXPECT_EQ(planners, 5u);
 }
 
 // A picker the tracker adds at run time (its latched list on /pickers/registry) is planned for: its beliefs on

@@ -1,5 +1,5 @@
-// rostest: rfid_ranging through ROS. Unknown tag, missing tf (unknown and empty antenna frame) and a stamp
-// going backwards publish nothing and do not stop the node; good reads before and after become identifying
+// rostest: rfid_ranging through ROS. Unknown tag, missing tf (unknown and empty antenna frame), a NaN RSSI, a
+// read stamped in 2100 and a stamp going backwards publish nothing and do not stop the node; good reads before and after become identifying
 // Observations over the nodes within read range of the antenna's tf pose; negative information for the
 // pickers not read; diagnostics count the drops.
 #include <geometry_msgs/TransformStamped.h>
@@ -47,6 +47,10 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
   send(reading("stranger", "robot_1/rfid_antenna", t0));  // unknown tag
   send(reading("rfid_0001", "robot_1/ghost", t0), 0.4);    // no tf for this frame: bounded wait, dropped
   send(reading("rfid_0001", "", t0));                      // empty frame
+  picker_localisation::RfidReading nan_rssi = reading("rfid_0001", "robot_1/rfid_antenna", t0);
+  nan_rssi.rssi = std::nan("");
+  send(nan_rssi);                                                                   // corrupted RSSI
+  send(reading("rfid_0001", "robot_1/rfid_antenna", ros::Time(4102444800.0)));      // 2100: never adopted
   send(reading("rfid_0001", "robot_1/rfid_antenna", t0));  // good
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }, 10.0));
   send(reading("rfid_0001", "robot_1/rfid_antenna", t0 - ros::Duration(2.0)));  // backwards
@@ -82,6 +86,8 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2"; }, 5.0)) << c.diag["dropped: no tf"];
   EXPECT_EQ(c.diag["rejected: unknown tag"], "1");
   EXPECT_EQ(c.diag["rejected: out of order"], "1");
+  EXPECT_EQ(c.diag["rejected: not finite"], "1");
+  EXPECT_EQ(c.diag["stamped in the future (dropped)"], "1");
 }
 
 // A picker added to the tracker at run time (its list on /pickers/registry): its tag is read as its own.

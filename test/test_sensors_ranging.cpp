@@ -201,6 +201,36 @@ TEST(GnssIngest, RejectsBadFixesAndKeepsGoing) {
   EXPECT_EQ(c.out_of_order, 2u);
 }
 
+// Issue 17: five 50 km glitches re-anchored the jump gate and the belief snapped 23 m to the nearest node. A fix
+// farther than max_map_distance from every node is rejected before the gate: nothing re-anchors, the next fix
+// near the last good one is accepted without a gate reset.
+TEST(GnssIngest, FixesFarOffTheMapAreRejectedNotSnapped) {
+  GnssFixture fx;  // lattice -20 .. 20 m
+  GnssIngest gnss("picker_1", fx.map, fx.datum);
+  ASSERT_TRUE(gnss.process(fx.fixAt(1.0, {0.0, 0.0})).accepted());
+  for (int k = 1; k <= 5; ++k) {
+    const GnssResult r = gnss.process(fx.fixAt(1.0 + 0.1 * k, {50000.0, 0.0}));
+    EXPECT_EQ(r.rejection, GnssRejection::kOffMap) << r.reason;
+    EXPECT_FALSE(r.observation.has_value());
+  }
+  const GnssResult good = gnss.process(fx.fixAt(2.0, {0.5, 0.0}));
+  ASSERT_TRUE(good.accepted()) << good.reason;
+  EXPECT_NEAR(good.observation->position->x(), 0.5, 1e-3);
+  EXPECT_EQ(gnss.counters().off_map, 5u);
+  EXPECT_EQ(gnss.counters().gate_resets, 0u);
+  // 45 m beyond the lattice's edge (65 m from the centre) is still on the map's doorstep: accepted (after a
+  // blackout, so the gate does not judge the 65 m move).
+  EXPECT_TRUE(gnss.process(fx.fixAt(20.0, {65.0, 0.0})).accepted());
+  EXPECT_EQ(gnss.process(fx.fixAt(40.0, {71.0, 0.0})).rejection, GnssRejection::kOffMap);  // 51 m off
+  // 0 disables the check.
+  GnssIngestOptions o;
+  o.max_map_distance = 0.0;
+  GnssIngest unlimited("picker_1", fx.map, fx.datum, o);
+  EXPECT_TRUE(unlimited.process(fx.fixAt(1.0, {50000.0, 0.0})).accepted());
+  o.max_map_distance = -1.0;
+  EXPECT_NE(o.validate().find("max_map_distance"), std::string::npos);
+}
+
 TEST(GnssIngest, ImpossibleJumpGateAndReanchoring) {
   GnssFixture fx;
   GnssIngest gnss("picker_1", fx.map, fx.datum);  // max_speed 3 m/s, gate 5 sigma, reset after 5
@@ -656,6 +686,33 @@ TEST(UwbRanging, BatchesAnchorsIntoOneObservationAndRejectsBadInput) {
   EXPECT_EQ(c.out_of_range, 1u);
   EXPECT_EQ(c.out_of_order, 1u);
   EXPECT_EQ(c.updates, 2u);
+}
+
+// Issue 17 soak: every tag ever ranged kept its grids (~6 MB each; 180 MB per robot with 30 pickers). A tag not
+// ranged for reset_after s is freed at the next flush; it restarts from the uniform prior, as it would have.
+TEST(UwbRanging, FiltersOfTagsOutOfRangeAreFreed) {
+  auto map = latticeMap(10.0, 0.5);
+  UwbRanging uwb(twoPickers(), map);  // reset_after 5 s
+  const Eigen::Isometry2d robot = Eigen::Isometry2d::Identity();
+  const Eigen::Vector2d person(2.0, 1.0);
+  std::vector<core::Observation> out;
+  auto rangeAll = [&](double t, const std::string& tag) {
+    for (int a = 0; a < 3; ++a) uwb.addRange(uwbInput(t + 0.01 * a, tag, a, (person - kAnchors[a]).norm()), robot, &out);
+    uwb.flush(t + 0.2, &out);
+  };
+  rangeAll(1.0, "uwb_1");
+  rangeAll(1.5, "uwb_2");
+  EXPECT_NE(uwb.filter("uwb_1"), nullptr);
+  EXPECT_NE(uwb.filter("uwb_2"), nullptr);
+  rangeAll(5.5, "uwb_2");  // uwb_1 last ranged 4.5 s before: kept
+  EXPECT_NE(uwb.filter("uwb_1"), nullptr);
+  rangeAll(7.0, "uwb_2");  // 6 s: freed
+  EXPECT_EQ(uwb.filter("uwb_1"), nullptr);
+  EXPECT_NE(uwb.filter("uwb_2"), nullptr);
+  const std::size_t before = out.size();
+  rangeAll(8.0, "uwb_1");  // back in range: a fresh filter, which publishes again
+  EXPECT_NE(uwb.filter("uwb_1"), nullptr);
+  EXPECT_GT(out.size(), before);
 }
 
 TEST(UwbRanging, AmbiguousOrEdgeEstimatesAreNotPublished) {

@@ -71,6 +71,7 @@ TEST(UwbRangingNode, BadRangesAreDroppedAndGoodOnesStillPublish) {
   send(range("uwb_0001", "robot_1/uwb_anchor_0", -1.0, t0));              // negative
   send(range("uwb_0001", "robot_1/uwb_anchor_9", 3.0, t0), 0.4);          // anchor without tf
   send(range("uwb_0001", "robot_9/uwb_anchor_0", 3.0, t0, "robot_9"), 0.4);  // robot without tf
+  send(range("uwb_0001", "robot_1/uwb_anchor_0", 3.0, ros::Time(4102444800.0)));  // 2100: never adopted
   // Camera: one detection straight at the picker from the front camera.
   picker_localisation::BearingDetectionArray b;
   b.header.stamp = t0;
@@ -80,6 +81,10 @@ TEST(UwbRangingNode, BadRangesAreDroppedAndGoodOnesStillPublish) {
   b.detections[0].bearing = std::atan2(rel.y(), rel.x() - 0.6);
   b.detections[0].confidence = 0.9;
   cam.publish(b);
+  ranging_test::spinFor(0.1);
+  picker_localisation::BearingDetectionArray future = b;  // detections stamped 2100: dropped, counted
+  future.header.stamp = ros::Time(4102444800.0);
+  cam.publish(future);
   ranging_test::spinFor(0.1);
   sendGood(t0);
   ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }, 10.0));
@@ -104,6 +109,7 @@ TEST(UwbRangingNode, BadRangesAreDroppedAndGoodOnesStillPublish) {
   EXPECT_EQ(c.diag["rejected: out of order"], "1");
   EXPECT_EQ(c.diag["RHF updates"], "2");
   EXPECT_EQ(c.diag["camera detection sets"], "1");
+  EXPECT_EQ(c.diag["stamped in the future (dropped)"], "2");
 }
 
 int main(int argc, char** argv) {

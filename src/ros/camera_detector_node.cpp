@@ -48,7 +48,7 @@ CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.setHardwareID(robot_id_.empty() ? "camera_detector" : robot_id_);
   diagnostics_.add("camera detector", this, &CameraDetectorNode::diagnose);
   // The updater publishes only when update() is called (it was never called: nothing on /diagnostics).
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_timer_.start(nh_, diagnostics_);
   ok_ = true;
   ROS_INFO("%s: %s detector, at most %.1f Hz", ros::this_node::getName().c_str(), onnx.empty() ? "HOG" : "ONNX",
            max_rate_);

@@ -23,6 +23,8 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pnh.param("duration", duration_, 0.0);
   pnh.param<std::string>("output_csv", output_csv_, "");
   pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
+  pnh.param("max_truth_distance", max_truth_distance_, max_truth_distance_);
+  clock_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   if (!(sample_rate > 0.0)) {
     ROS_FATAL("evaluator: ~sample_rate must be > 0 (got %g)", sample_rate);
     return;
@@ -51,6 +53,7 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   beliefs_->follow(registry.ids());
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
+  diagnostics_timer_.start(nh, diagnostics_);
   sample_period_ = 1.0 / sample_rate;
   // The timer only polls; samples fall on the stamp grid (see the header).
   timer_ = nh.createTimer(ros::Duration(std::min(sample_period_, 0.1)), &Evaluator::onTimer, this);
@@ -68,6 +71,12 @@ void Evaluator::onBelief(const picker_localisation::PickerBelief& belief) {
   Picker& p = pickers_[found->second];
   ++p.beliefs;
   if (belief.estimated_node.empty()) return;  // not initialised yet
+  if (clock_guard_.tooFarInFuture(belief.header.stamp)) {
+    ++p.future;
+    ROS_WARN_THROTTLE(5.0, "evaluator: belief of %s stamped %.3f, far ahead of the clock (ignored)", p.id.c_str(),
+                      belief.header.stamp.toSec());
+    return;
+  }
   if (!map_->index(belief.estimated_node)) {
     ++p.unknown_nodes;
     ROS_WARN_THROTTLE(5.0, "evaluator: belief of %s names unknown node '%s' (ignored)", p.id.c_str(),
@@ -84,6 +93,20 @@ void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPt
   if (!t.allFinite()) {
     ++p.not_finite;
     ROS_WARN_THROTTLE(5.0, "evaluator: non-finite ground truth of %s (ignored)", p.id.c_str());
+    return;
+  }
+  if (clock_guard_.tooFarInFuture(msg->header.stamp)) {
+    ++p.future;
+    ROS_WARN_THROTTLE(5.0, "evaluator: ground truth of %s stamped %.3f, far ahead of the clock (ignored)",
+                      p.id.c_str(), msg->header.stamp.toSec());
+    return;
+  }
+  // A truth far off the map would be scored against the nearest node as if the picker stood there.
+  const double off = (map_->position2d(map_->nearestNode(t)) - t).norm();
+  if (max_truth_distance_ > 0.0 && off > max_truth_distance_) {
+    ++p.off_map;
+    ROS_WARN_THROTTLE(5.0, "evaluator: ground truth of %s is %.0f m from the nearest map node (> max_truth_distance "
+                      "%.0f m; ignored)", p.id.c_str(), off, max_truth_distance_);
     return;
   }
   p.truth_history.emplace_back(msg->header.stamp.toSec(), t);
@@ -144,12 +167,19 @@ void Evaluator::onTimer(const ros::TimerEvent&) {
   if (done_ || first_truth_ < 0.0) return;
   const double now = ros::Time::now().toSec();
   if (next_sample_ < 0.0) next_sample_ = std::ceil(first_truth_ / sample_period_) * sample_period_;
+  // A first truth stamped long before the clock (or a long pause) would be caught up one period at a time
+  // (a billion samples for a stamp near 0 under wall time): only the last max_catch_up s are sampled.
+  const double oldest = now - ordering_latency_ - max_catch_up_;
+  if (next_sample_ < oldest) {
+    ROS_WARN_THROTTLE(5.0, "evaluator: %.0f s of stamp time not sampled (ground truth stamped long before the clock)",
+                      oldest - next_sample_);
+    next_sample_ = std::ceil(oldest / sample_period_) * sample_period_;
+  }
   while (!done_ && next_sample_ <= now - ordering_latency_) {
     sampleAt(next_sample_);
     if (duration_ > 0.0 && next_sample_ >= first_truth_ + duration_) done_ = true;
     next_sample_ += sample_period_;
   }
-  diagnostics_.update();
   if (done_) {
     finish();
     ros::shutdown();
@@ -185,9 +215,17 @@ void Evaluator::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
     stat.add(p.id + " ground truths", p.truths);
     stat.add(p.id + " samples", p.samples.size());
     if (!p.estimated_node || !p.truth) ++waiting;
-    rejected += p.unknown_nodes + p.not_finite;
+    rejected += p.unknown_nodes + p.not_finite + p.off_map + p.future;
+  }
+  std::size_t off_map = 0, future = 0;
+  for (const Picker& p : pickers_) {
+    off_map += p.off_map;
+    future += p.future;
   }
   stat.add("rejected messages", rejected);
+  stat.add("ground truths off the map", off_map);
+  stat.add("stamped in the future", future);
+  stat.add("clock jumps back", clock_guard_.jumps());
   if (rejected > 0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "rejected beliefs / ground truths (see counts)");
   else if (waiting > 0)

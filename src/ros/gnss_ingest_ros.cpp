@@ -109,7 +109,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   updater_.setHardwareID("gnss_ingest");
   silence_.configure(pnh, "GNSS fixes");
   updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
-  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  diag_timer_.start(nh, updater_);
   ok_ = true;
 }
 
@@ -478,9 +478,10 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     const std::string k = g.pickerId() + " ";
     stat.add(k + "received", c.received);
     stat.add(k + "accepted", c.accepted);
-    stat.add(k + "rejected no_fix/not_finite/negative_cov/out_of_order/jump",
+    stat.add(k + "rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map",
              std::to_string(c.no_fix) + "/" + std::to_string(c.not_finite) + "/" + std::to_string(c.negative_covariance) +
-                 "/" + std::to_string(c.out_of_order) + "/" + std::to_string(c.impossible_jump));
+                 "/" + std::to_string(c.out_of_order) + "/" + std::to_string(c.impossible_jump) + "/" +
+                 std::to_string(c.off_map));
     stat.add(k + "blackouts (ended)", c.blackouts);
     stat.add(k + "longest blackout [s]", c.longest_blackout);
     const double age = g.ageOfLastFix(now);

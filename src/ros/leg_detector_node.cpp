@@ -1,5 +1,6 @@
 #include "picker_localisation/ros/leg_detector_node.h"
 
+#include <pcl/console/print.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <picker_localisation/PersonDetectionArray.h>
 #include <ros/package.h>
@@ -32,7 +33,7 @@ std::string cloudProblem(const sensor_msgs::PointCloud2& c) {
     if (!f) return std::string("no field ") + axis;
     if (f->datatype != sensor_msgs::PointField::FLOAT32)
       return std::string("field ") + axis + " is not FLOAT32";
-    if (f->offset + 4u > c.point_step) return std::string("field ") + axis + " lies beyond point_step";
+    if (static_cast<std::uint64_t>(f->offset) + 4u > c.point_step) return std::string("field ") + axis + " lies beyond point_step";
   }
   return "";
 }
@@ -43,6 +44,10 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   pnh_.param("robot_id", robot_id_, robot_id_);
   pnh_.param("tf_timeout", tf_timeout_, tf_timeout_);
   pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
+  pnh_.param("max_beams", max_beams_, max_beams_);
+  // PCL prints its own unthrottled errors for degenerate clouds (VoxelGrid overflow, RANSAC without a model);
+  // malformed clouds are reported here instead, once per throttle period.
+  pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
 
   // The pipeline's options: every private parameter through the schema the offline runner uses too.
@@ -90,7 +95,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.setHardwareID(robot_id_.empty() ? "leg_detector" : robot_id_);
   diagnostics_.add("leg detector", this, &LegDetectorNode::diagnose);
   // The updater publishes only when update() is called (it was never called: nothing on /diagnostics).
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_timer_.start(nh_, diagnostics_);
   ok_ = true;
   ROS_INFO("%s: %zu scan topic(s), model %s, fixed frame %s%s", ros::this_node::getName().c_str(),
            scan_topics.size(), model.c_str(), fixed_frame_.c_str(),
@@ -99,6 +104,11 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
 bool LegDetectorNode::lookup(const std::string& target, const std::string& source, const ros::Time& stamp,
                              Eigen::Isometry3d& out) {
+  if (target.empty() || source.empty()) {  // tf2 would print a line per lookup of an empty frame
+    ++tf_failures_;
+    ROS_WARN_THROTTLE(5.0, "%s: input without a frame id dropped", ros::this_node::getName().c_str());
+    return false;
+  }
   try {
     const auto t = tf_buffer_.lookupTransform(target, source, stamp, ros::Duration(tf_timeout_)).transform;
     out = Eigen::Translation3d(t.translation.x, t.translation.y, t.translation.z) *
@@ -130,6 +140,12 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   if (msg->header.frame_id.empty()) {
     ++tf_failures_;
     ROS_WARN_THROTTLE(5.0, "%s: scan without a frame id dropped", ros::this_node::getName().c_str());
+    return;
+  }
+  if (max_beams_ > 0 && msg->ranges.size() > static_cast<std::size_t>(max_beams_)) {
+    ++bad_scans_;
+    ROS_WARN_THROTTLE(5.0, "%s: scan of %zu beams dropped (more than ~max_beams %d: a 2D laser has a few thousand)",
+                      ros::this_node::getName().c_str(), msg->ranges.size(), max_beams_);
     return;
   }
   last_input_ = msg->header.stamp;
@@ -195,7 +211,7 @@ void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::
                                     const std::vector<sensors::PersonCandidate>& people) {
   // The newest camera frame within fusion_max_age, each used once (Algorithm 4 cones).
   std::optional<sensors::CameraCones> camera;
-  if (last_detections_ && std::abs((last_detections_->header.stamp - stamp).toSec()) <= fusion_max_age_) {
+  if (last_detections_ && std::abs(secondsBetween(stamp, last_detections_->header.stamp)) <= fusion_max_age_) {
     Eigen::Isometry3d cam;
     if (lookup(last_detections_->header.frame_id, fixed_frame_, last_detections_->header.stamp, cam)) {
       camera.emplace();
@@ -256,6 +272,7 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("tf failures (dropped)", tf_failures_);
   stat.add("stamps in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("malformed clouds (dropped)", bad_clouds_);
+  stat.add("scans over max_beams (dropped)", bad_scans_);
   stat.add("non-finite camera detections (dropped)", bad_detections_);
   stat.add("clock jumps back", stamp_guard_.jumps());
   stat.add("camera frames", camera_frames_);

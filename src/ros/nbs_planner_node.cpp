@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/ros/map_conversions.h"
@@ -51,6 +52,7 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   pnh_.param("battery_level", battery_level_, 1.0);
   pnh_.param("claim_timeout", claim_timeout_, 30.0);
   pnh_.param("tf_timeout", tf_timeout_, 0.2);
+  pnh_.param("max_pose_age", max_pose_age_, max_pose_age_);
   pnh_.param("use_what_if", use_what_if_, true);
   pnh_.param("what_if_seed", what_if_seed_, 1);
   double period = 5.0;
@@ -115,10 +117,8 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
   diagnostics_.setHardwareID(robot_id_);
   diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);
-  timer_ = nh_.createTimer(ros::Duration(period), [this](const ros::TimerEvent&) {
-    planOnce();
-    diagnostics_.update();
-  });
+  timer_ = nh_.createTimer(ros::Duration(period), [this](const ros::TimerEvent&) { planOnce(); });
+  diagnostics_timer_.start(nh_, diagnostics_);
   ROS_INFO("%s: robot %s, policy %s, %zu pickers (beliefs from %s), %zu other robots, planning every %.1f s",
            name.c_str(), robot_id_.c_str(), nbs::toString(config.policy), pickers_.size(),
            beliefs_->topic().c_str(), peer_subs_.size(), period);
@@ -192,8 +192,21 @@ std::optional<topology::NodeIndex> NbsPlannerNode::robotNode() {
         tf_buffer_.lookupTransform(map_frame_, base_frame_, ros::Time(0), ros::Duration(tf_timeout_));
     const Eigen::Vector2d p(t.transform.translation.x, t.transform.translation.y);
     if (!p.allFinite()) throw tf2::TransformException("non-finite robot position");
+    // When the robot's localisation stops, tf keeps serving its last pose: planning from it would send the
+    // robot from where it was. A zero stamp is a static chain (a fixed robot): never stale.
+    const double age = secondsBetween(t.header.stamp, ros::Time::now());
+    if (max_pose_age_ > 0.0 && !t.header.stamp.isZero() && age > max_pose_age_) {
+      ++stale_poses_;
+      char why[128];
+      std::snprintf(why, sizeof(why), "robot pose %.1f s old (> max_pose_age %.1f s)", age, max_pose_age_);
+      last_problem_ = why;
+      ROS_WARN_THROTTLE(10.0, "%s: the robot pose %s -> %s is %.1f s old (> ~max_pose_age %.1f s): not planning",
+                        ros::this_node::getName().c_str(), map_frame_.c_str(), base_frame_.c_str(), age,
+                        max_pose_age_);
+      return std::nullopt;
+    }
     return map_->nearestNode(p);
-  } catch (const tf2::TransformException& e) {
+  } catch (const std::exception& e) {  // tf2::TransformException, and ros::Duration's range error
     ++tf_failures_;
     last_problem_ = std::string("no robot pose: ") + e.what();
     ROS_WARN_THROTTLE(10.0, "%s: no pose %s -> %s: %s", ros::this_node::getName().c_str(), map_frame_.c_str(),
@@ -377,6 +390,7 @@ void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("plans", plans_);
   stat.add("plans without goal", failed_plans_);
   stat.add("tf failures", tf_failures_);
+  stat.add("stale robot poses", stale_poses_);
   stat.add("plans on the fallback belief (no what-if)", fallback_plans_);
   stat.add("other robots' goals known", peer_goals_.size());
   stat.add("other robots' goals rejected", peer_goals_rejected_);

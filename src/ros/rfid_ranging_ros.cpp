@@ -37,7 +37,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   updater_.setHardwareID("rfid_ranging");
   silence_.configure(pnh, "RFID reads");
   updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);
-  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  diag_timer_.start(nh, updater_);
   registry_sub_ = followPickerList(nh, pnh, "rfid_ranging", [this](const core::PickerRegistry& r) {
     model_->setRegistry(r);
     ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());

@@ -35,9 +35,7 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
     diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh);
     diagnostics_->setHardwareID(map_file);
     diagnostics_->add("topological map", this, &TopologicalMapServer::diagnose);
-    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
-      diagnostics_->update();
-    });
+    diagnostics_timer_.start(nh, *diagnostics_, 1.0, /*wall=*/true);
     ok_ = true;
   } catch (const topology::MapError& e) {
     ROS_FATAL("topological_map_server: %s", e.what());

@@ -279,8 +279,7 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   updatePredictionTimer();
   diagnostics_.setHardwareID("tpf_tracker");
   diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
-  diagnostics_timer_ =
-      nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { diagnostics_.update(); });
+  diagnostics_timer_.start(nh, diagnostics_);
   ROS_INFO("tpf_tracker: %zu picker(s), map '%s' (%zu nodes), ordering latency %.2f s (%s)", tracks_.size(),
            map_->name().c_str(), map_->numNodes(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "fused on arrival");

@@ -64,7 +64,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   updater_.setHardwareID("uwb_ranging");
   silence_.configure(pnh, "UWB ranges");
   updater_.add("UWB ranging", this, &UwbRangingNode::diagnose);
-  diag_timer_ = nh.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_.update(); });
+  diag_timer_.start(nh, updater_);
   registry_sub_ = followPickerList(nh, pnh, "uwb_ranging", [this](const core::PickerRegistry& r) {
     uwb_->setRegistry(r);
     ROS_INFO("uwb_ranging: picker list from the tracker: %zu picker(s)", r.size());

@@ -25,6 +25,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
   core::readOption(y, c, "max_speed", o.max_speed);
   core::readOption(y, c, "jump_gate_sigmas", o.jump_gate_sigmas);
   core::readOption(y, c, "blackout_timeout", o.blackout_timeout);
+  core::readOption(y, c, "max_map_distance", o.max_map_distance);
   auto count = [&](const char* key, std::size_t& value) {
     long v = static_cast<long>(value);
     core::readOption(y, c, key, v);
@@ -42,7 +43,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
     std::vector<std::string> known = {
         "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
-        "blackout_timeout", "pickers_file", "datum_file",        "datum_source",      "map_file",
+        "blackout_timeout", "max_map_distance", "pickers_file", "datum_file",        "datum_source",      "map_file",
         "map_timeout",      "frame_id",     "observation_topic", "map_topic", "max_future_stamp", "silent_warn_after",
         "people_pose_topics", "people_pose_sensor", "people_pose_sigma", "pose_topic_format", "pose_sensor",
         "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
@@ -69,6 +70,7 @@ std::string GnssIngestOptions::validate() const {
   if (!(max_speed > 0.0)) return bad("max_speed", max_speed, "> 0");
   if (!(jump_gate_sigmas >= 0.0)) return bad("jump_gate_sigmas", jump_gate_sigmas, ">= 0");
   if (!(blackout_timeout > 0.0)) return bad("blackout_timeout", blackout_timeout, "> 0");
+  if (!(max_map_distance >= 0.0)) return bad("max_map_distance", max_map_distance, ">= 0 (0: no limit)");
   std::string problem = bias.validate();
   if (problem.empty()) problem = association.validate();
   return problem;
@@ -135,6 +137,8 @@ const char* toString(GnssRejection r) {
       return "out_of_order";
     case GnssRejection::kImpossibleJump:
       return "impossible_jump";
+    case GnssRejection::kOffMap:
+      return "off_map";
   }
   return "unknown";
 }
@@ -206,6 +210,15 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
     std::ostringstream s;
     s << "stamp " << fix.stamp << " s is not after the last accepted fix (" << last_->stamp << " s)";
     return reject(GnssRejection::kOutOfOrder, s.str(), counters_.out_of_order);
+  }
+
+  if (options_.max_map_distance > 0.0 && map_->numNodes() > 0) {
+    const double off = (map_->position2d(map_->nearestNode(p)) - p).norm();
+    if (off > options_.max_map_distance) {
+      std::ostringstream s;
+      s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance << " m)";
+      return reject(GnssRejection::kOffMap, s.str(), counters_.off_map);
+    }
   }
 
   bool after_blackout = false;

@@ -173,12 +173,13 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     ++counter;
     return result;
   };
-  if (!std::isfinite(read.stamp) || !read.antenna_pose.allFinite())
-    return reject(RfidRejection::kNotFinite, "stamp or antenna pose is NaN/Inf", counters_.not_finite);
+  // A NaN / Inf RSSI is a corrupted read, not a reader without RSSI (those report a number): rejected.
+  if (!std::isfinite(read.stamp) || !read.antenna_pose.allFinite() || !std::isfinite(read.rssi))
+    return reject(RfidRejection::kNotFinite, "stamp, antenna pose or RSSI is NaN/Inf", counters_.not_finite);
   const std::optional<std::string> picker = registry_.pickerForRfidTag(read.tag_id);
   if (!picker)
     return reject(RfidRejection::kUnknownTag, "unknown tag '" + read.tag_id + "'", counters_.unknown_tag);
-  if (std::isfinite(read.rssi) && read.rssi < options_.min_rssi) {
+  if (read.rssi < options_.min_rssi) {
     std::ostringstream s;
     s << "RSSI " << read.rssi << " dBm below min_rssi " << options_.min_rssi;
     return reject(RfidRejection::kWeakSignal, s.str(), counters_.weak_signal);

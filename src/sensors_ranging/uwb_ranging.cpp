@@ -94,6 +94,7 @@ UwbRejection UwbRanging::addRange(const UwbRangeInput& in, const Eigen::Isometry
   }
   ++counters_.accepted;
   st.last_stamp = in.stamp;
+  newest_stamp_ = std::max(newest_stamp_, in.stamp);
   if (st.batch && (in.stamp - st.batch->first_stamp > options_.batch_window ||
                    std::find(st.batch->anchors.begin(), st.batch->anchors.end(), in.anchor_id) != st.batch->anchors.end()))
     processBatch(in.tag_id, st, out);
@@ -140,6 +141,12 @@ void UwbRanging::addBearings(const CameraBearings& bearings) {
 void UwbRanging::flush(double now, std::vector<core::Observation>* out) {
   for (auto& [tag, st] : tags_)
     if (st.batch && now - st.batch->first_stamp > options_.batch_window) processBatch(tag, st, out);
+  // A tag not ranged for reset_after s (by the newest range's stamp) would restart from the uniform prior
+  // anyway: its grids (~6 MB at the default 20 m x 20 m, 5 cm) are freed, so memory grows with the tags in
+  // range, not with every tag ever seen (a 30-picker soak: 180 MB per robot before).
+  for (auto it = tags_.begin(); it != tags_.end();)
+    it = !it->second.batch && newest_stamp_ - it->second.last_stamp > options_.reset_after ? tags_.erase(it)
+                                                                                           : std::next(it);
 }
 
 void UwbRanging::processBatch(const std::string& tag, TagState& st, std::vector<core::Observation>* out) {

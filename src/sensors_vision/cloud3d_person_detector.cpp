@@ -19,8 +19,10 @@ std::vector<Cloud3dPerson> Cloud3dPersonDetector::detect(const pcl::PointCloud<p
   std::vector<Cloud3dPerson> out;
   auto finite = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   for (const auto& p : cloud.points)
+    // z is gated too: a finite but huge z (1e38 from a corrupted cloud) overflowed the voxel grid's sums into
+    // Inf, and PCL's k-d tree aborts the process on an Inf point (found by test_fuzz_inputs).
     if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
-        std::hypot(p.x, p.y) <= options_.max_range)
+        std::hypot(p.x, p.y) <= options_.max_range && std::abs(p.z) <= options_.max_range)
       finite->push_back(p);
   if (finite->empty()) return out;
 

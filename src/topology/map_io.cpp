@@ -11,6 +11,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -235,6 +236,9 @@ TopologicalMap parseMapDom(const std::string& text, const std::string& source, M
 }  // namespace
 
 TopologicalMap parseMap(const std::string& text, const std::string& source, MapFormat format) {
+  if (text.size() > kMaxMapBytes)
+    throw MapError(source, "map text of " + std::to_string(text.size()) + " bytes exceeds the limit of " +
+                               std::to_string(kMaxMapBytes) + " bytes");
   TopologicalMap map = parseMapDom(text, source, format);
 #if defined(__GLIBC__)
   // The yaml-cpp document of a large map is ~20x the file (357 MB peak for a 20,400-node map); it is gone now, but
@@ -245,6 +249,18 @@ TopologicalMap parseMap(const std::string& text, const std::string& source, MapF
 }
 
 TopologicalMap loadMap(const std::string& path, MapFormat format) {
+  // A device (/dev/zero), a FIFO or a directory would be read for ever or fail obscurely: regular files only,
+  // and none larger than the parser can hold.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status)) {
+    if (!std::filesystem::is_regular_file(status))
+      throw MapError(path, "not a regular file (a directory, device or pipe)");
+    const auto size = std::filesystem::file_size(path, ec);
+    if (!ec && size > kMaxMapBytes)
+      throw MapError(path, "file of " + std::to_string(size) + " bytes exceeds the limit of " +
+                               std::to_string(kMaxMapBytes) + " bytes");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw MapError(path, "cannot open the file for reading");
   std::ostringstream buffer;

@@ -13,15 +13,21 @@ namespace picker_localisation {
 namespace topology {
 
 namespace {
+// A map error is one log line: a part longer than this (a 2 MB token of a broken file) is cut.
+std::string clipped(const std::string& text, std::size_t max = 160) {
+  if (text.size() <= max) return text;
+  return text.substr(0, max) + "... (" + std::to_string(text.size()) + " characters)";
+}
+
 std::string formatMapError(const std::string& file, const std::string& problem, const std::string& node,
                            const std::string& field) {
   std::ostringstream s;
-  s << file << ": " << problem;
+  s << clipped(file) << ": " << clipped(problem, 400);
   if (!node.empty() || !field.empty()) {
     s << " (";
-    if (!node.empty()) s << "node '" << node << "'";
+    if (!node.empty()) s << "node '" << clipped(node) << "'";
     if (!node.empty() && !field.empty()) s << ", ";
-    if (!field.empty()) s << "field '" << field << "'";
+    if (!field.empty()) s << "field '" << clipped(field) << "'";
     s << ")";
   }
   return s.str();

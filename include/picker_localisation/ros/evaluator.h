@@ -13,6 +13,7 @@
 // stamped <= t_k. So the errors depend on the messages' stamps, never on when a timer fired.
 #pragma once
 
+#include "picker_localisation/ros/diagnostics_timer.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 
@@ -54,7 +55,7 @@ class Evaluator {
     ros::Subscriber truth_sub;
     ros::Publisher error_pub;
     std::vector<eval::ErrorSample> samples;
-    std::size_t beliefs = 0, truths = 0, unknown_nodes = 0, not_finite = 0;
+    std::size_t beliefs = 0, truths = 0, unknown_nodes = 0, not_finite = 0, off_map = 0, future = 0;
   };
   void onBelief(const picker_localisation::PickerBelief& msg);
   void onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg);
@@ -70,11 +71,14 @@ class Evaluator {
   double first_truth_ = -1.0;  // ROS time of the first ground truth, s
   double sample_period_ = 1.0, ordering_latency_ = 1.5;
   double next_sample_ = -1.0;  // next grid time t_k to sample, s
-  StampGuard clock_guard_;     // jump-back detection only
+  double max_truth_distance_ = 50.0;  // m, a truth farther from every node is not scored (not snapped)
+  double max_catch_up_ = 60.0;        // s, at most this much stamp time is sampled after a gap
+  StampGuard clock_guard_;     // jump-back detection and stamps too far in the future
   void sampleAt(double t);
   std::string output_csv_;
   ros::Timer timer_;
   diagnostic_updater::Updater diagnostics_;
+  DiagnosticsTimer diagnostics_timer_;
 };
 
 }  // namespace ros_adapter

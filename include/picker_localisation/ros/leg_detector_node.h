@@ -3,6 +3,7 @@
 // person on /observations. Fusion with a camera when ~detections_topic is set (seed 003 Algorithm 4).
 #pragma once
 
+#include "picker_localisation/ros/diagnostics_timer.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/BearingDetectionArray.h>
 #include <ros/ros.h>
@@ -53,6 +54,7 @@ class LegDetectorNode {
   bool ok_ = false;
   std::string fixed_frame_ = "map", robot_id_;
   double tf_timeout_ = 0.1, fusion_max_age_ = 0.5;
+  int max_beams_ = 20000;  // ~max_beams: larger scans are dropped (0: any size)
   // Detector, per-sensor-frame trackers and camera fusion: the same core pipeline the offline runner uses.
   std::unique_ptr<sensors::LegPipeline> pipeline_;
   sensors::Cloud3dPersonDetector cloud_detector_;
@@ -64,9 +66,10 @@ class LegDetectorNode {
   picker_localisation::BearingDetectionArray::ConstPtr last_detections_;
   sensor_msgs::CameraInfo::ConstPtr camera_info_;
   diagnostic_updater::Updater diagnostics_;
-  ros::Timer diagnostics_timer_;  // calls diagnostics_.update() at 1 Hz (ROS time)
+  DiagnosticsTimer diagnostics_timer_;  // publishes diagnostics_ at 1 Hz (ROS time)
   std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
-              camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0, bad_detections_ = 0;
+              camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0, bad_detections_ = 0,
+              bad_scans_ = 0;
   StampGuard stamp_guard_;
   ros::Time last_input_;
 };

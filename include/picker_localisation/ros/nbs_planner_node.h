@@ -10,6 +10,7 @@
 // read. Parameters: config/nbs.yaml.
 #pragma once
 
+#include "picker_localisation/ros/diagnostics_timer.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -77,6 +78,8 @@ class NbsPlannerNode {
   double battery_level_ = 1.0;
   double claim_timeout_ = 30.0;
   double tf_timeout_ = 0.2;
+  double max_pose_age_ = 5.0;  // s, an older map -> base_link is stale: no plan (0: any age)
+  std::size_t stale_poses_ = 0;
   bool use_what_if_ = true;
   int what_if_seed_ = 1;
   std::vector<std::unique_ptr<PickerInput>> pickers_;  // in the order of the list
@@ -94,6 +97,7 @@ class NbsPlannerNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   diagnostic_updater::Updater diagnostics_;
+  DiagnosticsTimer diagnostics_timer_;
 
   std::optional<nbs::PlanResult> last_plan_;
   ros::Time last_plan_stamp_;

@@ -3,6 +3,7 @@
 // config/gnss_ingest.yaml, config/rfid_ranging.yaml, config/uwb_ranging.yaml.
 #pragma once
 
+#include "picker_localisation/ros/diagnostics_timer.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -155,7 +156,7 @@ class GnssIngestNode {
   double ordering_latency_ = 0.0;
   ros::Timer ordering_timer_;
   diagnostic_updater::Updater updater_;
-  ros::Timer diag_timer_;
+  DiagnosticsTimer diag_timer_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   std::size_t picker_poses_ = 0, bad_poses_ = 0;
   std::string people_pose_sensor_ = "people", pose_sensor_ = "pose", pose_topic_format_;
@@ -187,7 +188,7 @@ class RfidRangingNode {
   ros::Subscriber registry_sub_;
   ros::Publisher pub_;
   diagnostic_updater::Updater updater_;
-  ros::Timer diag_timer_;
+  DiagnosticsTimer diag_timer_;
   std::size_t tf_failures_ = 0, published_ = 0;
   StampGuard stamp_guard_;
   SilenceWatch silence_;
@@ -224,7 +225,7 @@ class UwbRangingNode {
   ros::Publisher pub_;
   ros::WallTimer flush_timer_;
   diagnostic_updater::Updater updater_;
-  ros::Timer diag_timer_;
+  DiagnosticsTimer diag_timer_;
   std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
   StampGuard stamp_guard_;
   SilenceWatch silence_;

@@ -27,10 +27,12 @@ class StampGuard {
   explicit StampGuard(double max_future = 10.0, double jump_tolerance = 1.0)
       : max_future_(max_future), jump_tolerance_(jump_tolerance) {}
   // True (and counted) when `stamp` lies more than max_future s after the node's clock. Before the clock runs
-  // (sim time 0) nothing is too far.
+  // (sim time, no /clock yet: now is 0) the reference is the wall clock: no recorded or simulated stamp can be
+  // later than today, and a stamp adopted then would block the node as surely as later.
   bool tooFarInFuture(const ros::Time& stamp) {
-    const double now = ros::Time::now().toSec();
-    const bool far = now > 0.0 && max_future_ > 0.0 && stamp.toSec() - now > max_future_;
+    double now = ros::Time::now().toSec();
+    if (now <= 0.0) now = ros::WallTime::now().toSec();
+    const bool far = max_future_ > 0.0 && stamp.toSec() - now > max_future_;
     if (far) ++future_stamps_;
     return far;
   }

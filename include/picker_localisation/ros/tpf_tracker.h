@@ -39,6 +39,7 @@
 // picker's id), frame_id (map), max_future_stamp (10 s).
 #pragma once
 
+#include "picker_localisation/ros/diagnostics_timer.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <std_msgs/String.h>
@@ -154,7 +155,8 @@ class TpfTracker {
   bool flush_scheduled_ = false;
   OnDemandTopics on_demand_;
   ros::ServiceServer add_srv_, remove_srv_, list_srv_;
-  ros::Timer prediction_timer_, diagnostics_timer_, ordering_timer_;
+  ros::Timer prediction_timer_, ordering_timer_;
+  DiagnosticsTimer diagnostics_timer_;
   double timer_period_ = 0.0;
   core::StampOrderedBuffer<Pending> ordering_;
   double ordering_latency_ = 0.0;

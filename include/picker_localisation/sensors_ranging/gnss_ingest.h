@@ -40,6 +40,7 @@ enum class GnssRejection {
   kNegativeCovariance,  // a negative horizontal variance, or a horizontal block that is not PSD
   kOutOfOrder,          // stamp <= the stamp of the last accepted fix (repeated or going backwards)
   kImpossibleJump,      // fails the jump gate (see GnssIngestOptions)
+  kOffMap,              // farther than max_map_distance from every map node (not snapped to the nearest)
 };
 const char* toString(GnssRejection r);
 
@@ -82,6 +83,10 @@ struct GnssIngestOptions {
   double jump_gate_sigmas = 5.0;    // gate in standard deviations (0 disables the gate)
   std::size_t jump_reset_count = 5;
   double blackout_timeout = 10.0;   // s without an accepted fix = blackout (velocity window restarts after it)
+  // A fix this far (m) from every map node says nothing about the map: it is rejected before the jump gate, so
+  // it neither re-anchors the gate nor snaps the belief to the nearest node (a 50 km glitch moved it 23 m).
+  // 0 disables. 50 m: ten times the worst Table I bias, beyond any lane a picker can be in.
+  double max_map_distance = 50.0;
   GnssBiasOptions bias;             // the device's bias estimate (gnss_bias.h), keys bias_*
   PickerAssociationOptions association;  // identity of anonymous people detections, keys association_*
 
@@ -114,7 +119,7 @@ struct GnssResult {
 
 struct GnssCounters {
   std::size_t received = 0, accepted = 0, no_fix = 0, not_finite = 0, negative_covariance = 0, out_of_order = 0,
-              impossible_jump = 0, gate_resets = 0, blackouts = 0;
+              impossible_jump = 0, off_map = 0, gate_resets = 0, blackouts = 0;
   double longest_blackout = 0.0;  // s
 };
 

@@ -93,12 +93,16 @@ class UwbRanging {
                         std::vector<core::Observation>* out, std::string* reason = nullptr);
   // Camera bearings for the next updates (kept until bearing_max_age has passed).
   void addBearings(const CameraBearings& bearings);
-  // Processes every batch whose window ended before `now` (s). Call periodically.
+  // Processes every batch whose window ended before `now` (s), and frees the filters of tags not ranged for
+  // reset_after s. Call periodically.
   void flush(double now, std::vector<core::Observation>* out);
 
   const UwbCounters& counters() const { return counters_; }
   // Forgets every tag's batch and filter (after the clock jumped back); counters stay.
-  void reset() { tags_.clear(); }
+  void reset() {
+    tags_.clear();
+    newest_stamp_ = -1e300;
+  }
   // The pickers changed at run time (tpf_tracker's list): a tag no longer worn by the same picker loses its
   // filter (it would carry the old wearer's position).
   void setRegistry(core::PickerRegistry registry);
@@ -128,7 +132,8 @@ class UwbRanging {
   core::PickerRegistry registry_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   UwbRangingOptions options_;
-  std::map<std::string, TagState> tags_;
+  std::map<std::string, TagState> tags_;  // tags ranged within reset_after of the newest range (flush evicts)
+  double newest_stamp_ = -1e300;           // newest accepted range, s
   std::vector<CameraBearings> bearings_;
   UwbCounters counters_;
 };
