@@ -3,7 +3,8 @@
 # with every simulated sensor, gnss_ingest, per robot rfid_ranging / uwb_ranging / leg_detector / nbs_planner,
 # tpf_tracker, evaluator) with PICKERS pickers for DURATION simulated seconds. Every node process's resident memory
 # and CPU time are sampled from /proc every few wall seconds; the last line is one JSON object: per node the RSS after
-# warm-up (the first quarter of the run), at the end and its maximum, the growth (end vs warm-up) in %, the mean CPU
+# warm-up (the first quarter of the run), at the end and its maximum, the growth (end vs warm-up) and the trend
+# (least-squares rise after warm-up) in %, the mean CPU
 # in cores, whether every node was still alive at the end, and the evaluator's right-lane share over all pickers.
 # Run it at a RATE the machine keeps up with (total CPU well below its cores): a saturated machine fills the
 # subscriber queues, and their memory is not the nodes'.
@@ -105,8 +106,15 @@ for n, v in sorted(by_node.items()):
     rss_warm, rss_end = warm[0][1] / 1024.0, v[-1][1] / 1024.0
     rss_max = max(s[1] for s in warm) / 1024.0
     cores = (v[-1][2] - v[0][2]) / max(v[-1][0] - v[0][0], 1e-9)
+    # Trend: least-squares line through the RSS after warm-up, its rise over that span in % of the mean (a node
+    # whose memory follows its load, uwb_ranging with the tags in range, fluctuates without growing).
+    ts, rs = [s[0] for s in warm], [s[1] / 1024.0 for s in warm]
+    mt, mr = sum(ts) / len(ts), sum(rs) / len(rs)
+    var = sum((t - mt) ** 2 for t in ts)
+    slope = sum((t - mt) * (r - mr) for t, r in zip(ts, rs)) / var if var > 0 else 0.0
     nodes[n] = {"rss_warm_mb": round(rss_warm, 1), "rss_end_mb": round(rss_end, 1), "rss_max_mb": round(rss_max, 1),
-                "growth_pct": round(100.0 * (rss_end - rss_warm) / rss_warm, 1), "cpu_cores": round(cores, 3),
+                "growth_pct": round(100.0 * (rss_end - rss_warm) / rss_warm, 1),
+                "trend_pct": round(100.0 * slope * (ts[-1] - ts[0]) / mr, 1), "cpu_cores": round(cores, 3),
                 "alive_at_end": alive.get(n) == "1"}
 text = open(log, errors="replace").read()
 # The evaluator keeps every sample for its table (memory grows with `duration` by design): not a robot node.
@@ -115,6 +123,7 @@ m = re.search(r"^all\s+(\d+)\s+([\d.]+)\s+[\d.]+\s+([\d.]+)\s+[\d.]+\s+([\d.]+)"
 print(json.dumps({"pickers": int(pickers), "duration_s": float(duration), "rate_factor": float(rate),
                   "robots": int(robots), "wall_s": round(end, 1),
                   "max_growth_pct_robot_nodes": max(v["growth_pct"] for v in robot_nodes.values()),
+                  "max_trend_pct_robot_nodes": max(v["trend_pct"] for v in robot_nodes.values()),
                   "total_rss_end_mb": round(sum(v["rss_end_mb"] for v in nodes.values()), 1),
                   "total_cpu_cores": round(sum(v["cpu_cores"] for v in nodes.values()), 3),
                   "all_alive": all(v["alive_at_end"] for v in robot_nodes.values()),

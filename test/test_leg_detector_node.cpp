@@ -115,23 +115,63 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
 
   // An empty scan (no returns) and a scan in a frame without tf: no output, no crash.
   const std::size_t before = rec.people.size();
-  auto empty = scans[0];
-  empty.header.stamp = ros::Time::now();
-  empty.header.frame_id = "right_laser";
-  std::fill(empty.ranges.begin(), empty.ranges.end(), std::numeric_limits<float>::infinity());
-  pub.publish(empty);
-  auto orphan = scans[1];
-  orphan.header.stamp = ros::Time::now();
-  orphan.header.frame_id = "no_such_laser";
-  pub.publish(orphan);
-  waitFor([] { return false; }, 1.0);
+  // Scan `i` of the bag, restamped, in `frame`, changed by `edit`.
+  auto sendScan = [&](std::size_t i, const std::string& frame, const ros::Time& stamp,
+                      const std::function<void(sensor_msgs::LaserScan&)>& edit = {}) {
+    auto s = scans[i];
+    s.header.stamp = stamp;
+    s.header.frame_id = frame;
+    if (edit) edit(s);
+    pub.publish(s);
+    waitFor([] { return false; }, 0.2);
+  };
+  sendScan(0, "right_laser", ros::Time::now(), [](sensor_msgs::LaserScan& s) {
+    std::fill(s.ranges.begin(), s.ranges.end(), std::numeric_limits<float>::infinity());
+  });
+  sendScan(1, "no_such_laser", ros::Time::now());
+  // Issue 17: a scan stamped 2100, one without a frame id (tf2 printed ~170 lines), one of 1,000,000 beams
+  // (blocked the node for 10 s), camera detections with an Inf bearing and in a frame without tf.
+  sendScan(2, "right_laser", ros::Time(4102444800.0));
+  sendScan(3, "", ros::Time::now());
+  sendScan(4, "right_laser", ros::Time::now(), [](sensor_msgs::LaserScan& s) { s.ranges.assign(1000000, 3.0f); });
+  waitFor([] { return false; }, 0.8);
   EXPECT_EQ(rec.people.size(), before);
+  std::map<std::string, std::string> diag;
+  auto diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& st : m->status)
+          if (st.name.find("leg detector") != std::string::npos)
+            for (const auto& kv : st.values) diag[kv.key] = kv.value;
+      });
+  ASSERT_TRUE(waitFor([&] { return diag["scans over max_beams (dropped)"] == "1"; }, 5.0))
+      << diag["scans over max_beams (dropped)"];
+  EXPECT_EQ(diag["stamps in the future (dropped)"], "1");
+  EXPECT_EQ(diag["tf failures (dropped)"], "2");  // no_such_laser and the scan without a frame id
   // Still alive: a good scan produces output again.
-  auto good = scans[40];
-  good.header.stamp = ros::Time::now();
-  good.header.frame_id = "right_laser";
-  pub.publish(good);
+  sendScan(40, "right_laser", ros::Time::now());
   EXPECT_TRUE(waitFor([&] { return rec.people.size() > before; }, 5.0)) << "leg_detector stopped publishing";
+  {
+    auto cam_bad = nh.advertise<picker_localisation::BearingDetectionArray>("camera/detections", 10);
+    ASSERT_TRUE(waitFor([&] { return cam_bad.getNumSubscribers() > 0; }, 10.0));
+    picker_localisation::BearingDetectionArray cam;
+    cam.header.stamp = ros::Time::now();
+    cam.header.frame_id = "right_laser";
+    cam.detections.resize(1);
+    cam.detections[0].bearing = std::numeric_limits<double>::infinity();
+    cam.detections[0].confidence = 0.9;
+    cam_bad.publish(cam);  // Inf bearing: dropped
+    waitFor([] { return false; }, 0.2);
+    cam.header.frame_id = "no_such_camera";
+    cam.detections[0].bearing = 0.1;
+    cam_bad.publish(cam);  // fused with the next scan: no tf, the scan is still published unfused
+    waitFor([] { return false; }, 0.2);
+    const std::size_t at = rec.people.size();
+    sendScan(41, "right_laser", cam.header.stamp);
+    EXPECT_TRUE(waitFor([&] { return rec.people.size() > at; }, 5.0)) << "no people after bad camera detections";
+    ASSERT_TRUE(waitFor([&] { return diag["non-finite camera detections (dropped)"] == "1"; }, 5.0))
+        << diag["non-finite camera detections (dropped)"];
+    EXPECT_EQ(diag["tf failures (dropped)"], "3");  // + the camera frame without tf
+  }
 
   // Fusion (Algorithm 4): a camera bearing towards the labelled legs, stamped like the scan, promotes the nearest
   // cluster in the cone to a camera-confirmed person ("lidar_camera", confidence >= 0.6) at the legs.
@@ -229,8 +269,30 @@ TEST(LegDetectorNode, PointCloudPerson) {
     bad.header.stamp = ros::Time(4102444800.0);  // 2100: ros::Duration threw in the tf lookup
     pub.publish(bad);
     waitFor([] { return false; }, 0.3);  // the node queues 2 clouds
+    // Well-formed metadata, hostile content: all NaN, and one point at z = 1e38 (its voxel sums overflowed
+    // into Inf and PCL's k-d tree aborted the process); a frame without tf; no frame id.
+    bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    for (sensor_msgs::PointCloud2Iterator<float> bx(bad, "x"); bx != bx.end(); ++bx) bx[0] = bx[1] = bx[2] = NAN;
+    pub.publish(bad);
+    waitFor([] { return false; }, 0.3);
+    bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    sensor_msgs::PointCloud2Iterator<float>(bad, "z")[0] = 1e38f;
+    pub.publish(bad);
+    waitFor([] { return false; }, 0.3);
+    bad = cloud;
+    bad.header.stamp = ros::Time::now();
+    bad.header.frame_id = "no_such_lidar";
+    pub.publish(bad);
+    waitFor([] { return false; }, 0.3);
+    bad.header.frame_id = "";
+    pub.publish(bad);
     waitFor([] { return false; }, 0.5);
-    EXPECT_TRUE(rec.people.empty());
+    std::size_t detections = 0;
+    for (const auto& a : rec.people)
+      detections += a.detections.size();  // a single good-shaped cloud is not yet a confirmed track either
+    EXPECT_EQ(detections, 0u) << "people from a malformed or unlocated cloud";
     EXPECT_EQ(picker_localisation::ros_adapter::cloudProblem(cloud), "");
     // Counted in diagnostics (published at 1 Hz).
     std::map<std::string, std::string> diag;
@@ -243,7 +305,7 @@ TEST(LegDetectorNode, PointCloudPerson) {
     ASSERT_TRUE(waitFor([&] { return diag.count("malformed clouds (dropped)") > 0 &&
                                      diag["malformed clouds (dropped)"] == "3"; }, 5.0))
         << diag["malformed clouds (dropped)"];
-    EXPECT_EQ(diag["stamps in the future (dropped)"], "1");
+    EXPECT_EQ(diag["stamps in the future (dropped)"], "2");  // + the scan of RealScansEmptyScanAndMissingTf (one node)
   }
   for (int k = 0; k < 5; ++k) {
     cloud.header.stamp = ros::Time::now();
