@@ -87,9 +87,12 @@ TEST(EvaluatorNode, HandComputedErrorsAndBadInput) {
   EXPECT_EQ(f.errors.back().topological_error, 0);
   EXPECT_TRUE(f.errors.back().in_true_lane);
 
-  // Bad input: an unknown node name and a NaN truth are ignored; the last valid values stay in use.
+  // Bad input: an unknown node name, a NaN truth and a truth 1,000 km off the map (it was scored against the
+  // nearest node) are ignored; the last valid values stay in use.
   f.sendBelief("NoSuchNode");
   f.sendTruth(std::nan(""), 0.0);
+  ros::WallDuration(0.2).sleep();
+  f.sendTruth(1e6, 0.0);
   ros::WallDuration(0.5).sleep();
   ASSERT_TRUE(f.waitFor([](const picker_localisation::TrackingError&) { return true; }));
   for (const auto& err : f.errors) {
