@@ -38,6 +38,16 @@ struct Recorder {
   void onObservation(const picker_localisation::Observation::ConstPtr& m) { observations.push_back(*m); }
 };
 
+// The leg detector's diagnostics values, kept up to date in `diag` while the subscriber lives.
+ros::Subscriber followDiagnostics(ros::NodeHandle& nh, std::map<std::string, std::string>& diag) {
+  return nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&diag](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
+        for (const auto& st : m->status)
+          if (st.name.find("leg detector") != std::string::npos)
+            for (const auto& kv : st.values) diag[kv.key] = kv.value;
+      });
+}
+
 }  // namespace
 
 TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
@@ -137,12 +147,7 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
   waitFor([] { return false; }, 0.8);
   EXPECT_EQ(rec.people.size(), before);
   std::map<std::string, std::string> diag;
-  auto diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-        for (const auto& st : m->status)
-          if (st.name.find("leg detector") != std::string::npos)
-            for (const auto& kv : st.values) diag[kv.key] = kv.value;
-      });
+  auto diag_sub = followDiagnostics(nh, diag);
   ASSERT_TRUE(waitFor([&] { return diag["scans over max_beams (dropped)"] == "1"; }, 5.0))
       << diag["scans over max_beams (dropped)"];
   EXPECT_EQ(diag["stamps in the future (dropped)"], "1");
@@ -296,12 +301,7 @@ TEST(LegDetectorNode, PointCloudPerson) {
     EXPECT_EQ(picker_localisation::ros_adapter::cloudProblem(cloud), "");
     // Counted in diagnostics (published at 1 Hz).
     std::map<std::string, std::string> diag;
-    auto diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
-        "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& m) {
-          for (const auto& st : m->status)
-            if (st.name.find("leg detector") != std::string::npos)
-              for (const auto& kv : st.values) diag[kv.key] = kv.value;
-        });
+    auto diag_sub = followDiagnostics(nh, diag);
     ASSERT_TRUE(waitFor([&] { return diag.count("malformed clouds (dropped)") > 0 &&
                                      diag["malformed clouds (dropped)"] == "3"; }, 5.0))
         << diag["malformed clouds (dropped)"];

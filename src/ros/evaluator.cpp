@@ -102,7 +102,7 @@ void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPt
     return;
   }
   // A truth far off the map would be scored against the nearest node as if the picker stood there.
-  const double off = (map_->position2d(map_->nearestNode(t)) - t).norm();
+  const double off = map_->distanceToNearestNode(t);
   if (max_truth_distance_ > 0.0 && off > max_truth_distance_) {
     ++p.off_map;
     ROS_WARN_THROTTLE(5.0, "evaluator: ground truth of %s is %.0f m from the nearest map node (> max_truth_distance "
@@ -209,16 +209,13 @@ void Evaluator::finish() {
 }
 
 void Evaluator::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  std::size_t waiting = 0, rejected = 0;
+  std::size_t waiting = 0, rejected = 0, off_map = 0, future = 0;
   for (const Picker& p : pickers_) {
     stat.add(p.id + " beliefs", p.beliefs);
     stat.add(p.id + " ground truths", p.truths);
     stat.add(p.id + " samples", p.samples.size());
     if (!p.estimated_node || !p.truth) ++waiting;
     rejected += p.unknown_nodes + p.not_finite + p.off_map + p.future;
-  }
-  std::size_t off_map = 0, future = 0;
-  for (const Picker& p : pickers_) {
     off_map += p.off_map;
     future += p.future;
   }

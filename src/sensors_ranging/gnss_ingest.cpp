@@ -213,7 +213,7 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   }
 
   if (options_.max_map_distance > 0.0 && map_->numNodes() > 0) {
-    const double off = (map_->position2d(map_->nearestNode(p)) - p).norm();
+    const double off = map_->distanceToNearestNode(p);
     if (off > options_.max_map_distance) {
       std::ostringstream s;
       s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance << " m)";

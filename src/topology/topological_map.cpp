@@ -354,6 +354,11 @@ NodeIndex TopologicalMap::nearestNode(const Eigen::Vector2d& p) const {
   return impl_->kdtree.nearest(p);
 }
 
+double TopologicalMap::distanceToNearestNode(const Eigen::Vector2d& p) const {
+  if (nodes_.empty()) return std::numeric_limits<double>::infinity();
+  return (position2d(nearestNode(p)) - p).norm();
+}
+
 std::vector<NodeIndex> TopologicalMap::nodesWithin(const Eigen::Vector2d& p, double radius) const {
   std::vector<NodeIndex> out;
   if (!(radius >= 0.0) || nodes_.empty()) return out;

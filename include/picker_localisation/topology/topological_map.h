@@ -133,6 +133,8 @@ class TopologicalMap {
 
   // Nearest node to a point in the xy-plane (k-d tree, O(log n)).
   NodeIndex nearestNode(const Eigen::Vector2d& p) const;
+  // Distance (m, xy-plane) from p to that node; +inf for an empty map. How far off the map a point is.
+  double distanceToNearestNode(const Eigen::Vector2d& p) const;
   // Nodes within radius (m) of p, in no particular order (k-d tree range search).
   std::vector<NodeIndex> nodesWithin(const Eigen::Vector2d& p, double radius) const;
 
