@@ -46,4 +46,15 @@ for f in /dev/zero "$tmp/a_directory" "$tmp/long_token.tmap2"; do
     echo "ok: $f -> rc 2: $out"
   fi
 done
+# Issue 13: rosrun finds the tool after `make` (rosrun skips every path below <package>/build/, so the devel space
+# must live outside it: make puts it in build-devel/). The third argument is the devel space of this build.
+devel="${3:-}"
+if [ -n "$devel" ]; then
+  case "$(cd "$devel" && pwd -P)/" in
+    "$(cd "$pkg" && pwd -P)/build/"*) echo "FAIL: the devel space $devel is below $pkg/build/, where rosrun never looks (build with make)"; fail=1 ;;
+    *) out="$(cd /tmp && bash -c "source '$devel/setup.bash' && rosrun picker_localisation tmap_info '$pkg/config/maps/riseholme.tmap2'" 2>&1)"
+       if printf '%s\n' "$out" | grep -q '^nodes: 138$'; then echo "ok: rosrun picker_localisation tmap_info from the devel space"
+       else echo "FAIL: rosrun tmap_info from the devel space: $out"; fail=1; fi ;;
+  esac
+fi
 exit $fail

@@ -651,7 +651,9 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.prediction_rate, 0.25);
   EXPECT_EQ(p.motion_model, tpf::MotionModel::kVelocity);
   EXPECT_TRUE(p.jsd_monitor);
-  EXPECT_EQ(p.reinit_sensors, (std::vector<std::string>{"gnss", "uwb", "pose"}));  // measured default (tpf.md); pose: map-frame positions, as GNSS
+  EXPECT_EQ(p.reinit_sensors,
+            (std::vector<std::string>{
+                "gnss", "uwb", "pose"}));  // measured default (tpf.md); pose: map-frame positions, as GNSS
   EXPECT_EQ(p.gammaFor("pose").node, 1.0);
   EXPECT_EQ(p.gammaFor("people").node, 0.25);
   EXPECT_TRUE(p.entropy_gate);
@@ -988,4 +990,88 @@ TEST(TpfLaneChange, VelocityFollowsTheEdgeAndParticlesReverse) {
   std::size_t reversed = 0;
   for (const auto& q : g.particles()) reversed += q.vx < 0.0f ? 1 : 0;
   EXPECT_NEAR(static_cast<double>(reversed) / g.particles().size(), 1.0 - std::exp(-0.05 * 2.0), 0.01);
+}
+
+// ------------------------------------------------------------------------------ GNSS bias per particle
+// ------
+namespace {
+// A GNSS observation as gnss_ingest builds it: the corrected fix, its node likelihood, the bias removed and
+// its covariance (the prior before any sighting), the device's drift rate.
+core::Observation biasedFix(const topology::TopologicalMap& map, double stamp,
+                            const Eigen::Vector2d& corrected, double fix_variance,
+                            const Eigen::Vector2d& bias_removed, double bias_variance, double drift_rate) {
+  core::Observation o = obsAt(stamp, {}, {});
+  o.position = corrected;
+  o.position_covariance = fix_variance * Eigen::Matrix2d::Identity();
+  core::setGaussianLikelihood(o, map, corrected, o.position_covariance);
+  o.bias_removed = bias_removed;
+  o.bias_covariance = bias_variance * Eigen::Matrix2d::Identity();
+  o.bias_drift_rate = drift_rate;
+  return o;
+}
+}  // namespace
+
+TEST(TpfGnssBias, KalmanUpdatePerParticleAndPredictiveWeights) {
+  // Lane map, nodes 3 m apart: R = gnss_bias_fix_std^2 + 3^2 / 12 = 1 + 0.75. Particles half at n1 (x = 3),
+  // half at n2 (x = 6). Fix: corrected (3.5, 0) + removed bias (0.5, 0) = raw (4, 0); prior variance 2, no
+  // drift. n1: y = 4 - 3 - 0.5 = 0.5 ... per axis: y1 = (0.5, 0), y2 = (-2.5, 0); S = 3.75, K = 2 / 3.75.
+  // Weights N(y; 0, S I) (the node likelihood L is not used): w1 / w2 = exp(-0.5 (0.25 - 6.25) / 3.75) =
+  // e^0.8.
+  auto map = laneMap();
+  TpfParams p = staticParams(2000);
+  p.gnss_bias_state = true;
+  p.gnss_bias_fix_std = 1.0;
+  TopologicalParticleFilter f(map, p, 3);
+  const NodeIndex n1 = *map->index("n1"), n2 = *map->index("n2");
+  ASSERT_TRUE(f.update(obsAt(0.0, {n1, n2}, {1.0, 1.0}, true, "uwb")).ok());
+  const double at_n1 = nodeFractions(f.particles())[n1];  // ~0.5, drawn
+  core::Observation o = biasedFix(*map, 0.0, {3.5, 0.0}, 1.0, {0.5, 0.0}, 2.0, 0.0);
+  o.nodes = {n1, n2};
+  o.likelihood = {0.01, 1.0};  // favours n2: ignored by the bias state
+  const auto r = f.update(o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_FALSE(r.reinitialised);
+  const double ratio = std::exp(0.8);
+  EXPECT_NEAR(f.belief().massOf(n1), at_n1 * ratio / (at_n1 * ratio + 1.0 - at_n1), 1e-6);
+  const double s = 3.75, k = 2.0 / s;
+  for (const Particle& q : f.particles()) {
+    const double y = q.node == n1 ? 0.5 : -2.5;
+    EXPECT_NEAR(q.bias_x, 0.5 + k * y, 1e-5);
+    EXPECT_NEAR(q.bias_y, 0.0, 1e-6);
+    EXPECT_NEAR(q.bias_variance, 2.0 * 1.75 / s, 1e-5);
+  }
+  // The next fix 10 s later: each variance grows by drift_rate * 10 before the update.
+  core::Observation later = biasedFix(*map, 10.0, {3.5, 0.0}, 1.0, {0.5, 0.0}, 2.0, 0.01);
+  ASSERT_TRUE(f.update(later).ok());
+  const double v0 = 2.0 * 1.75 / s + 0.1, v1 = v0 * 1.75 / (v0 + 1.75);
+  for (const Particle& q : f.particles()) EXPECT_NEAR(q.bias_variance, v1, 1e-5);
+}
+
+TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {
+  // The picker stands in lane 5 (a sighting put the belief there); its phone's fixes sit on lane 6, a
+  // constant bias of one lane spacing, reported with the phone's 3 m. Fused as independent fixes (bias state
+  // off), every fix favours lane 6 a little and particles that jump there (p_rj) take over; with the bias
+  // state, the particles of lane 5 learn the bias and predict every fix, and a jumper, starting from the 3.2
+  // m prior, cannot.
+  auto map = polytunnel();
+  const NodeIndex here = *map->index("r5_5"), there = *map->index("r6_5");
+  const Eigen::Vector2d bias = map->position2d(there) - map->position2d(here);
+  auto laneShare = [&](bool bias_state) {
+    TpfParams p = staticParams(500);
+    p.gnss_bias_state = bias_state;
+    p.unconnected_jump_probability = 0.01;
+    p.entropy_gate = false;
+    TopologicalParticleFilter f(map, p, 17);
+    EXPECT_TRUE(f.update(obsAt(0.0, {here}, {1.0}, true, "uwb")).ok());
+    for (int k = 1; k <= 300; ++k)
+      EXPECT_TRUE(f.update(biasedFix(*map, k, map->position2d(here) + bias, 9.0, {0.0, 0.0}, 10.25,
+                                     2.0 * 6.25 / 300.0))
+                      .ok());
+    double share = 0.0;
+    for (std::size_t j = 0; j < f.belief().nodes.size(); ++j)
+      if (map->lane(f.belief().nodes[j]) == map->lane(here)) share += f.belief().masses[j];
+    return share;
+  };
+  EXPECT_GT(laneShare(true), 0.9);
+  EXPECT_LT(laneShare(false), 0.5);
 }

@@ -40,7 +40,9 @@ void setGaussianLikelihood(Observation& obs, const topology::TopologicalMap& map
   }
   if (options.max_nodes > 0 && scored.size() > options.max_nodes) {
     std::partial_sort(scored.begin(), scored.begin() + static_cast<long>(options.max_nodes), scored.end(),
-                      [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+                      [](const auto& a, const auto& b) {
+                        return a.first > b.first || (a.first == b.first && a.second < b.second);
+                      });
     scored.resize(options.max_nodes);
     std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   }
@@ -62,16 +64,28 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   for (std::size_t i = 0; i < obs.nodes.size(); ++i) {
     if (obs.nodes[i] >= map.numNodes()) return "node index out of range";
     if (!seen.insert(obs.nodes[i]).second) return "node listed twice";
-    if (!std::isfinite(obs.likelihood[i]) || obs.likelihood[i] < 0.0) return "likelihood is negative or not finite";
+    if (!std::isfinite(obs.likelihood[i]) || obs.likelihood[i] < 0.0)
+      return "likelihood is negative or not finite";
     total += obs.likelihood[i];
   }
   if (!(total > 0.0)) return "likelihood sums to zero";
   if (obs.velocity && !obs.velocity->allFinite()) return "velocity is not finite";
+  if (obs.position && (!obs.position->allFinite() || !obs.position_covariance.allFinite()))
+    return "position or its covariance is not finite";
+  if (obs.bias_removed) {
+    const Eigen::Matrix2d& c = obs.bias_covariance;
+    if (!obs.bias_removed->allFinite() || !c.allFinite()) return "bias or its covariance is not finite";
+    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) + 1e-12)
+      return "bias covariance is not positive semi-definite";
+    if (!obs.position) return "bias without a position";
+    if (!std::isfinite(obs.bias_drift_rate) || obs.bias_drift_rate < 0.0)
+      return "bias drift rate is negative or not finite";
+  }
   return "";
 }
 
-bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
-                    const std::string& picker_id) {
+bool concernsPicker(bool identifying, const std::string& identified,
+                    const std::vector<std::string>& candidates, const std::string& picker_id) {
   if (identifying) return identified == picker_id;
   return candidates.empty() || std::find(candidates.begin(), candidates.end(), picker_id) != candidates.end();
 }

@@ -29,12 +29,22 @@ picker_localisation::Observation toMsg(const core::Observation& obs, const topol
   msg.position.y = obs.position ? obs.position->y() : nan;
   msg.position.z = obs.position ? 0.0 : nan;
   for (int r = 0; r < 2; ++r)
-    for (int c = 0; c < 2; ++c) msg.position_covariance[static_cast<std::size_t>(r * 3 + c)] = obs.position_covariance(r, c);
+    for (int c = 0; c < 2; ++c)
+      msg.position_covariance[static_cast<std::size_t>(r * 3 + c)] = obs.position_covariance(r, c);
+  msg.has_bias = obs.bias_removed.has_value();
+  if (obs.bias_removed) {
+    msg.bias_removed.x = obs.bias_removed->x();
+    msg.bias_removed.y = obs.bias_removed->y();
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 2; ++c)
+        msg.bias_covariance[static_cast<std::size_t>(r * 2 + c)] = obs.bias_covariance(r, c);
+    msg.bias_drift_rate = obs.bias_drift_rate;
+  }
   return msg;
 }
 
 core::Observation fromMsg(const picker_localisation::Observation& msg, const topology::TopologicalMap& map,
-                    std::size_t* unknown_nodes) {
+                          std::size_t* unknown_nodes) {
   core::Observation obs;
   obs.stamp = msg.header.stamp.toSec();
   obs.sensor = msg.sensor;
@@ -53,13 +63,22 @@ core::Observation fromMsg(const picker_localisation::Observation& msg, const top
     obs.nodes.push_back(*idx);
     obs.likelihood.push_back(msg.likelihood[i]);
   }
-  if (msg.nodes.size() != msg.likelihood.size()) obs.likelihood.push_back(std::numeric_limits<double>::quiet_NaN());
+  if (msg.nodes.size() != msg.likelihood.size())
+    obs.likelihood.push_back(std::numeric_limits<double>::quiet_NaN());
   if (unknown_nodes) *unknown_nodes = unknown;
   if (msg.has_velocity) obs.velocity = Eigen::Vector2d(msg.velocity.x, msg.velocity.y);
   if (std::isfinite(msg.position.x) && std::isfinite(msg.position.y)) {
     obs.position = Eigen::Vector2d(msg.position.x, msg.position.y);
     for (int r = 0; r < 2; ++r)
-      for (int c = 0; c < 2; ++c) obs.position_covariance(r, c) = msg.position_covariance[static_cast<std::size_t>(r * 3 + c)];
+      for (int c = 0; c < 2; ++c)
+        obs.position_covariance(r, c) = msg.position_covariance[static_cast<std::size_t>(r * 3 + c)];
+  }
+  if (msg.has_bias) {
+    obs.bias_removed = Eigen::Vector2d(msg.bias_removed.x, msg.bias_removed.y);
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c < 2; ++c)
+        obs.bias_covariance(r, c) = msg.bias_covariance[static_cast<std::size_t>(r * 2 + c)];
+    obs.bias_drift_rate = msg.bias_drift_rate;
   }
   return obs;
 }

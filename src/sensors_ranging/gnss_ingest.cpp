@@ -279,6 +279,10 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
     obs.position = p;
     obs.position_covariance = c_map;
   }
+  // What was removed and how well it is known: the TPF's per-particle bias state starts from it.
+  obs.bias_removed = bias_.applied(fix.stamp);
+  obs.bias_covariance = bias_.appliedCovariance(fix.stamp);
+  obs.bias_drift_rate = options_.bias.driftRate();
   core::setGaussianLikelihood(obs, *map_, *obs.position, obs.position_covariance, lo);
   if (options_.velocity_window >= 2 && window_.size() >= 2) {
     const double span = window_.back().stamp - window_.front().stamp;

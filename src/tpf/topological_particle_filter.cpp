@@ -72,6 +72,7 @@ struct TopologicalParticleFilter::MotionGraph {
   std::vector<std::uint32_t> offsets;  // |N| + 1
   std::vector<Arc> arcs;               // grouped by source node
   std::size_t max_degree = 0;
+  double median_arc_length = 0.0;  // m, node spacing (GNSS bias state: where the picker is between nodes)
   // Lane-change paths (TpfParams::lane_change_model): lane end, non-lane nodes..., adjacent lane's end, its
   // next lane node; exits of node n are exit_paths[exit_offsets[n] .. exit_offsets[n + 1]).
   std::vector<std::vector<NodeIndex>> lane_paths;
@@ -151,9 +152,9 @@ struct TopologicalParticleFilter::MotionGraph {
     }
   }
 
-  // A particle jumped from `from` to `to`, leaving its lane: 1 + the index of a lane-change path of `from` whose
-  // first step is that jump (the jump chose the side; when both sides share the first node, one at random), or
-  // 0 when there is none or the path already ends at `to`.
+  // A particle jumped from `from` to `to`, leaving its lane: 1 + the index of a lane-change path of `from`
+  // whose first step is that jump (the jump chose the side; when both sides share the first node, one at
+  // random), or 0 when there is none or the path already ends at `to`.
   std::uint32_t exitPathStartingWith(NodeIndex from, NodeIndex to, std::mt19937_64& rng) const {
     if (exit_offsets.empty()) return 0;
     const std::uint32_t begin = exit_offsets[from], end = exit_offsets[from + 1];
@@ -163,7 +164,8 @@ struct TopologicalParticleFilter::MotionGraph {
     if (found == 0) return 0;
     std::uint32_t skip = found > 1 ? static_cast<std::uint32_t>(rng() % found) : 0;
     for (std::uint32_t k = begin; k < end; ++k)
-      if (starts_with_to(k) && skip-- == 0) return lane_paths[exit_paths[k]].back() == to ? 0 : exit_paths[k] + 1;
+      if (starts_with_to(k) && skip-- == 0)
+        return lane_paths[exit_paths[k]].back() == to ? 0 : exit_paths[k] + 1;
     return 0;
   }
 
@@ -187,6 +189,13 @@ struct TopologicalParticleFilter::MotionGraph {
         }
         arcs.push_back(a);
       }
+    }
+    if (!arcs.empty()) {
+      std::vector<double> lengths;
+      lengths.reserve(arcs.size());
+      for (const Arc& a : arcs) lengths.push_back(a.length);
+      std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+      median_arc_length = lengths[lengths.size() / 2];
     }
     if (lane_change) buildLaneChangePaths(map, directed, max_hops);
   }
@@ -219,10 +228,14 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   if (!map_ || map_->numNodes() == 0) throw std::invalid_argument("TopologicalParticleFilter: empty map");
   const std::string problem = params_.validate();
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
-  graph_ = std::make_shared<const MotionGraph>(*map_, params_.directed_motion,
-                                               params_.lane_change_model &&
-                                                   params_.motion_model == MotionModel::kVelocity,
-                                               params_.lane_change_max_hops);
+  graph_ = std::make_shared<const MotionGraph>(
+      *map_, params_.directed_motion,
+      params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
+      params_.lane_change_max_hops);
+  // GNSS bias state: a fix spreads about the particle's node by gnss_bias_fix_std plus where the picker is
+  // between nodes (uniform over the node spacing: variance spacing^2 / 12), from the map, not tuned to one.
+  bias_fix_variance_ = params_.gnss_bias_fix_std * params_.gnss_bias_fix_std +
+                       graph_->median_arc_length * graph_->median_arc_length / 12.0;
   edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   node_scratch_a_.assign(map_->numNodes(), 0.0);
@@ -236,6 +249,8 @@ void TopologicalParticleFilter::reset() {
   weights_.clear();
   touched_.clear();
   belief_ = Belief();
+  bias_stamp_ = 0.0;
+  bias_variance_cap_ = 0.0;
   unconnected_p_ = params_.unconnected_jump_probability;
   belief_.unconnected_jump_probability = unconnected_p_;
 }
@@ -450,6 +465,7 @@ void TopologicalParticleFilter::redraw(const core::Observation& obs, std::size_t
     p.vy = static_cast<float>(vel(rng_));
     p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
     p.lane_change = 0;
+    p.bias_variance = -1.0f;  // the bias starts from the next GNSS fix's prior
   }
   unconnected_p_ = params_.unconnected_jump_probability;
 }
@@ -532,7 +548,8 @@ void TopologicalParticleFilter::predict(double dt) {
     if (path_next != topology::kInvalidNode) {
       const double speed = std::sqrt(vx * vx + vy * vy);
       for (std::uint32_t e = begin; e < end; ++e)
-        proj[e - begin] = g.arcs[e].length > 0.0 ? (g.arcs[e].target == path_next ? speed : leak * speed) : 0.0;
+        proj[e - begin] =
+            g.arcs[e].length > 0.0 ? (g.arcs[e].target == path_next ? speed : leak * speed) : 0.0;
       max_proj = speed;
     } else {
       for (std::uint32_t e = begin; e < end; ++e) {
@@ -641,9 +658,9 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   // Alg. 1 l. 6, with the guard that the observation must contradict the particles (mean L / max L below
   // reinit_max_mean_likelihood): a flat, negative-information likelihood ("not near this antenna") is far
   // from a concentrated belief in JSD yet agrees with it, and must not spread the belief over the map.
-  const bool may_reinit =
-      params_.reinit_sensors.empty() ||
-      std::find(params_.reinit_sensors.begin(), params_.reinit_sensors.end(), obs.sensor) != params_.reinit_sensors.end();
+  const bool may_reinit = params_.reinit_sensors.empty() ||
+                          std::find(params_.reinit_sensors.begin(), params_.reinit_sensors.end(),
+                                    obs.sensor) != params_.reinit_sensors.end();
   if (params_.jsd_monitor && may_reinit && obs.identifying && belief_.jsd > params_.jsd_threshold &&
       !result.initialised &&
       (mean_l < params_.reinit_max_mean_likelihood || params_.reinit_max_mean_likelihood >= 1.0)) {
@@ -675,6 +692,13 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
       obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity;
   const double base = params_.gamma_as_confidence ? 1.0 - gamma.node : 0.0;
   const double gq = gamma.node * inv_max;
+  // Node term of Eq. 8: gamma_q L^(q), or with the GNSS bias state gamma_q times the fix's predictive density
+  // given the particle's own bias (scaled to max 1).
+  const bool bias_state = params_.usesBiasState(obs.sensor) && obs.position && obs.bias_removed;
+  if (bias_state) weighWithBiasState(obs);
+  auto node_term = [&](std::size_t i, NodeIndex n) {
+    return (bias_state ? gamma.node * weights_[i] : gq * node_scratch_a_[n]) + base;
+  };
   std::vector<double>& mass = node_scratch_b_;
   touched_.clear();
   double total = 0.0;
@@ -689,7 +713,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   if (!velocity_term) {
     for (std::size_t i = 0; i < particles_.size(); ++i) {
       const NodeIndex n = particles_[i].node;
-      accumulate(i, n, gq * node_scratch_a_[n] + base);
+      accumulate(i, n, node_term(i, n));
     }
   } else {
     const float ox = static_cast<float>(obs.velocity->x()), oy = static_cast<float>(obs.velocity->y());
@@ -703,7 +727,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
       const float z = (speed - vs) * inv_sigma;
       const float denom = speed * vs;
       const float cosang = denom > 1e-12f ? (p.vx * ox + p.vy * oy) / denom : 0.0f;
-      const double wq = gq * node_scratch_a_[p.node] + base;
+      const double wq = node_term(i, p.node);
       const double wv = static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f)));
       accumulate(i, p.node, product ? wq * (1.0 + wv) : wq + wv);
     }
@@ -746,6 +770,45 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   return overlap;
 }
 
+void TopologicalParticleFilter::weighWithBiasState(const core::Observation& obs) {
+  // Rao-Blackwellised GNSS update (tpf_params.h, gnss_bias_state). Per axis and particle: the raw fix
+  // z = p(q) + b + e, e ~ N(0, R), R = gnss_bias_fix_std^2 + spacing^2 / 12; b a random walk of rate Q (the
+  // fix's bias_drift_rate, 2 drift_std^2 / drift_tau of gnss_ingest's device model). Predict var += Q dt
+  // (capped), weigh by N(z - p - b; 0, S I), S = var + R (normalised: particles with different variances
+  // compete fairly), update b += K (z - p - b), var = (1 - K) var, K = var / S.
+  const Eigen::Vector2d raw = *obs.position + *obs.bias_removed;
+  const double prior_variance = std::max(0.5 * obs.bias_covariance.trace(), 0.0);
+  bias_variance_cap_ = std::max(bias_variance_cap_, prior_variance);
+  const double dt = std::max(0.0, obs.stamp - bias_stamp_);
+  bias_stamp_ = std::max(bias_stamp_, obs.stamp);
+  const double grow = obs.bias_drift_rate * dt, cap = std::max(bias_variance_cap_, 1e-6);
+  const double r = bias_fix_variance_;
+  const float prior_x = static_cast<float>(obs.bias_removed->x()),
+              prior_y = static_cast<float>(obs.bias_removed->y());
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    Particle& p = particles_[i];
+    double var;
+    if (p.bias_variance < 0.0f) {
+      p.bias_x = prior_x;
+      p.bias_y = prior_y;
+      var = prior_variance;
+    } else {
+      var = std::min(static_cast<double>(p.bias_variance) + grow, cap);
+    }
+    const Eigen::Vector2d node = map_->position2d(p.node);
+    const double yx = raw.x() - node.x() - p.bias_x, yy = raw.y() - node.y() - p.bias_y;
+    const double s = var + r, k = var / s;
+    const double log_density = -0.5 * (yx * yx + yy * yy) / s - std::log(s);
+    weights_[i] = log_density;
+    best = std::max(best, log_density);
+    p.bias_x += static_cast<float>(k * yx);
+    p.bias_y += static_cast<float>(k * yy);
+    p.bias_variance = static_cast<float>(var * r / s);
+  }
+  for (double& w : weights_) w = std::exp(w - best);
+}
+
 void TopologicalParticleFilter::resample(double total) {
   const std::size_t n = particles_.size();
   if (params_.resampling == ResamplingScheme::kLowVariance) {
@@ -784,6 +847,7 @@ void TopologicalParticleFilter::addNoise() {
       particles_[i].node = static_cast<NodeIndex>(rng_() % n_nodes);
       particles_[i].dwell = 0.0f;
       particles_[i].lane_change = 0;
+      particles_[i].bias_variance = -1.0f;
     }
   }
   // The 32 spare random bits of each particle's prediction draw (spare_bits_, see normalTable()). The

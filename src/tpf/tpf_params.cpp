@@ -22,7 +22,8 @@ TpfParams::TpfParams() {
   // trusted as GNSS; other people detectors' anonymous poses (~people_pose_topics) as LiDAR.
   sensor_gammas["pose"] = SensorGamma{1.0, 0.0};
   sensor_gammas["people"] = SensorGamma{0.25, 0.0};
-  reinit_sensors = {"gnss", "uwb", "pose"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
+  reinit_sensors = {"gnss", "uwb",
+                    "pose"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
 }
 
 SensorGamma TpfParams::gammaFor(const std::string& sensor) const {
@@ -33,6 +34,11 @@ SensorGamma TpfParams::gammaFor(const std::string& sensor) const {
 bool TpfParams::acceptsSensor(const std::string& sensor) const {
   return accepted_sensors.empty() ||
          std::find(accepted_sensors.begin(), accepted_sensors.end(), sensor) != accepted_sensors.end();
+}
+
+bool TpfParams::usesBiasState(const std::string& sensor) const {
+  return gnss_bias_state &&
+         std::find(gnss_bias_sensors.begin(), gnss_bias_sensors.end(), sensor) != gnss_bias_sensors.end();
 }
 
 std::string TpfParams::validate() const {
@@ -71,6 +77,8 @@ std::string TpfParams::validate() const {
     return "unconnected_jump_probability must be in [0, 1]";
   if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate)) return "prediction_rate must be >= 0";
   if (!finite_nonneg(reorder_window)) return "reorder_window must be >= 0";
+  if (!(gnss_bias_fix_std > 0.0) || !std::isfinite(gnss_bias_fix_std))
+    return "gnss_bias_fix_std must be finite and > 0";
   return "";
 }
 
@@ -173,6 +181,9 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "unconnected_jump_probability", p.unconnected_jump_probability);
   read(node, "prediction_rate", p.prediction_rate);
   read(node, "reorder_window", p.reorder_window);
+  read(node, "gnss_bias_state", p.gnss_bias_state);
+  read(node, "gnss_bias_sensors", p.gnss_bias_sensors);
+  read(node, "gnss_bias_fix_std", p.gnss_bias_fix_std);
   if (node["method"]) {  // mode switches win
     try {
       p = presetForMethod(node["method"].as<std::string>(), p);
@@ -206,6 +217,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.jsd_monitor = true;
     p.reinit_fraction = 1.0;
     p.reinit_sensors.clear();
+    p.gnss_bias_state = false;
     return p;
   }
   if (method == "khan_connected" || method == "khan_unconnected") {
@@ -216,6 +228,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.accepted_sensors = {"gnss"};
     p.jsd_monitor = false;
     p.entropy_gate = false;
+    p.gnss_bias_state = false;  // each fix independent, as in [1]
     if (method == "khan_connected")
       p.unconnected_jump_probability = 0.0;
     else if (p.unconnected_jump_probability <= 0.0)

@@ -28,6 +28,13 @@ struct Observation {
   std::optional<Eigen::Vector2d> velocity;  // m/s, map frame
   std::optional<Eigen::Vector2d> position;  // metric position the likelihood came from, map frame, m
   Eigen::Matrix2d position_covariance = Eigen::Matrix2d::Zero();  // m^2
+  // GNSS fixes (gnss_ingest): the device bias estimate that was subtracted from the raw fix (raw fix = position +
+  // bias_removed; zero before any sighting), that estimate's covariance (the bias prior before any sighting) and
+  // how fast the bias wanders (2 drift_std^2 / drift_tau, m^2/s per axis). The TPF's per-particle bias state
+  // starts from them (tpf_params.h, gnss_bias_state). Empty for other sensors.
+  std::optional<Eigen::Vector2d> bias_removed;
+  Eigen::Matrix2d bias_covariance = Eigen::Matrix2d::Zero();  // m^2
+  double bias_drift_rate = 0.0;                               // m^2/s per axis
 
   bool empty() const { return nodes.empty(); }
   double totalLikelihood() const;

@@ -59,6 +59,8 @@ struct GnssBiasOptions {
   std::string validate() const;  // "" or "<key> = <value>: must be ..."
   // Covariance of the bias before any sighting: (offset_std^2 + drift_std^2) I.
   Eigen::Matrix2d priorCovariance() const;
+  // Rate at which the drift's variance grows over short times, 2 drift_std^2 / drift_tau, m^2/s per axis.
+  double driftRate() const { return 2.0 * drift_std * drift_std / drift_tau; }
   bool isSightingSensor(const std::string& sensor) const;  // sensor is in sighting_sensors
 };
 

@@ -68,13 +68,16 @@
 namespace picker_localisation {
 namespace tpf {
 
-// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter). 20 bytes with the
-// lane-change path index: single precision is ample for speeds (m/s) and dwell times (s) and halves the memory traffic of resampling.
+// One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter), plus the lane-change path
+// index and the GNSS bias state (TpfParams::gnss_bias_state): 32 bytes. Single precision is ample for speeds
+// (m/s), dwell times (s) and biases (m) and halves the memory traffic of resampling.
 struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
   float dwell = 0.0f;                                 // tau, s
   std::uint32_t lane_change = 0;  // 1 + index of the lane-change path being walked (0: none); see TpfParams
+  float bias_x = 0.0f, bias_y = 0.0f;  // GNSS device bias b given this particle's path, m, map frame
+  float bias_variance = -1.0f;         // per-axis variance of b, m^2; < 0: not started (next GNSS prior)
 };
 
 enum class UpdateStatus {
@@ -179,6 +182,10 @@ class TopologicalParticleFilter {
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
   bool weightAndResample(const core::Observation& obs, double max_likelihood);  // false: no overlap
+  // GNSS bias state: predictive density of the fix per particle (into weights_, scaled to max 1), then the
+  // per-particle Kalman update of b. Only for observations with usesBiasState(sensor), a position and a
+  // prior.
+  void weighWithBiasState(const core::Observation& obs);
   void resample(double total_weight);
   void addNoise();
   void recordBelief(bool counted);
@@ -200,7 +207,10 @@ class TopologicalParticleFilter {
   std::vector<double> projection_scratch_;  // per-edge projections b of one particle (max degree)
   std::vector<std::uint32_t> spare_bits_;   // per particle: random bits of the prediction draw used by Eq. 12
 
-  double unconnected_p_ = 0.0;  // p_rj
+  double unconnected_p_ = 0.0;      // p_rj
+  double bias_stamp_ = 0.0;         // s, stamp the particles' bias variances were last predicted to
+  double bias_variance_cap_ = 0.0;  // m^2, widest per-axis bias prior seen (cap of the random walk)
+  double bias_fix_variance_ = 1.0;  // m^2, R of the bias state's fix model (constructor)
   Belief belief_;
   FilterCounters counters_;
 };
