@@ -559,6 +559,7 @@ TEST(TpfBadInput, RejectedObservationsLeaveTheBeliefUntouched) {
       ASSERT_EQ(f.particles()[i].node, before[i].node);
       ASSERT_EQ(f.particles()[i].vx, before[i].vx);
       ASSERT_EQ(f.particles()[i].dwell, before[i].dwell);
+      ASSERT_EQ(f.particles()[i].bias_variance, before[i].bias_variance);
     }
     EXPECT_EQ(f.belief().stamp, belief_before.stamp);
     EXPECT_EQ(f.belief().masses, belief_before.masses);
@@ -583,6 +584,28 @@ TEST(TpfBadInput, RejectedObservationsLeaveTheBeliefUntouched) {
   core::Observation bad_velocity = obsAt(11.0, {10}, {1.0});
   bad_velocity.velocity = Eigen::Vector2d(nan, 0.0);
   cases.push_back({bad_velocity, UpdateStatus::kRejectedInvalid});
+  // GNSS bias fields (gnss_bias_state): checked before a particle's bias is touched.
+  auto with_bias = [&](const Eigen::Vector2d& removed, const Eigen::Matrix2d& cov, double rate,
+                       bool position) {
+    core::Observation o = obsAt(11.0, {10}, {1.0});
+    if (position) o.position = map->position2d(10);
+    o.bias_removed = removed;
+    o.bias_covariance = cov;
+    o.bias_drift_rate = rate;
+    return o;
+  };
+  const Eigen::Matrix2d one = Eigen::Matrix2d::Identity();
+  Eigen::Matrix2d not_psd;
+  not_psd << 1.0, 2.0, 2.0, 1.0;
+  for (const core::Observation& o :
+       {with_bias({nan, 0.0}, one, 0.0, true), with_bias({0.0, 0.0}, nan * one, 0.0, true),
+        with_bias({0.0, 0.0}, -one, 0.0, true), with_bias({0.0, 0.0}, not_psd, 0.0, true),
+        with_bias({0.0, 0.0}, one, -1.0, true), with_bias({0.0, 0.0}, one, nan, true),
+        with_bias({0.0, 0.0}, one, 0.0, false)})
+    cases.push_back({o, UpdateStatus::kRejectedInvalid});
+  core::Observation bad_position = obsAt(11.0, {10}, {1.0});
+  bad_position.position = Eigen::Vector2d(0.0, nan);
+  cases.push_back({bad_position, UpdateStatus::kRejectedInvalid});
   for (const auto& c : cases) {
     auto r = f.update(c.o);
     EXPECT_EQ(r.status, c.status) << r.reason;

@@ -22,8 +22,8 @@ TpfParams::TpfParams() {
   // trusted as GNSS; other people detectors' anonymous poses (~people_pose_topics) as LiDAR.
   sensor_gammas["pose"] = SensorGamma{1.0, 0.0};
   sensor_gammas["people"] = SensorGamma{0.25, 0.0};
-  reinit_sensors = {"gnss", "uwb",
-                    "pose"};  // not RFID: its read region is a ring, not a position (tpf_params.h)
+  // Not RFID: its read region is a ring, not a position (tpf_params.h).
+  reinit_sensors = {"gnss", "uwb", "pose"};
 }
 
 SensorGamma TpfParams::gammaFor(const std::string& sensor) const {

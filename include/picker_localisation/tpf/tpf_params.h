@@ -84,21 +84,20 @@ struct TpfParams {
   double lane_change_leak = 0.1;  // relative weight of the edges off the path, [0, 1]
   int lane_change_max_hops = 6;   // longest lane-change path searched, hops
 
-  // --- GNSS bias per particle (not in the paper; Khan et al., seed 001 Sec. VI)
-  // --------------------------------- A phone's fix is wrong by an almost constant 2-5 m: its errors are one
-  // slowly drifting bias, not independent draws. Fusing N fixes as independent (Eq. 8 literal) counts that
-  // one bias N times, so a bias of a lane spacing outvotes the lane carried by the motion model within a
-  // minute (mid-lane splits, lane ends decided by the bias). With gnss_bias_state each particle carries the
-  // device bias b (x, y) and its variance (a Rao-Blackwellised particle filter: a scalar Kalman filter per
-  // particle and axis). A fix z of a particle at node position p weighs it by the predictive density N(z - p
-  // - b; 0, (var + fix_std^2) I) and then updates b: the lane is told by how the fixes *move* (a lane change
-  // shifts them by a lane spacing), not by where they lie, unless the bias is known (after a sighting the
-  // prior from gnss_ingest is tight). The device model is gnss_ingest's (bias_offset_std, bias_drift_std,
-  // bias_drift_tau), carried by each fix: new or redrawn particles start from its prior
-  // (core::Observation::bias_removed / bias_covariance: the estimate after a sighting, else the bias prior),
-  // and b is a random walk of the fix's bias_drift_rate, its variance capped at the widest prior seen. Only
-  // observations of gnss_bias_sensors that carry a position and a bias prior use it; others weigh with L as
-  // Eq. 8.
+  // --- GNSS bias per particle (not in the paper; Khan et al., seed 001 Sec. VI) ----------------------------
+  // A phone's fix is wrong by an almost constant 2-5 m: its errors are one slowly drifting bias, not
+  // independent draws. Fusing N fixes as independent (Eq. 8 literal) counts that one bias N times, so a bias
+  // of a lane spacing outvotes the lane carried by the motion model within a minute (mid-lane splits, lane
+  // ends decided by the bias). With gnss_bias_state each particle carries the device bias b (x, y) and its
+  // variance (a Rao-Blackwellised particle filter: a scalar Kalman filter per particle and axis). A fix z of
+  // a particle at node position p weighs it by the predictive density N(z - p - b; 0, (var + R) I) and then
+  // updates b: the lane is told by how the fixes *move* (a lane change shifts them by a lane spacing), not by
+  // where they lie, unless the bias is known (after a sighting the prior from gnss_ingest is tight). The
+  // device model is gnss_ingest's (bias_offset_std, bias_drift_std, bias_drift_tau), carried by each fix: new
+  // or redrawn particles start from its prior (core::Observation::bias_removed / bias_covariance: the
+  // estimate after a sighting, else the bias prior), and b is a random walk of the fix's bias_drift_rate, its
+  // variance capped at the widest prior seen. Only observations of gnss_bias_sensors that carry a position
+  // and a bias prior use it; others weigh with L as Eq. 8.
   bool gnss_bias_state = true;
   std::vector<std::string> gnss_bias_sensors{"gnss"};
   // m, per-axis spread of a fix about the particle's node once b is removed, besides where the picker is
