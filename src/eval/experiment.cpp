@@ -329,6 +329,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   const core::PickerRegistry registry(registry_entries);
   // What gnss_ingest keeps of the trackers' published beliefs (the association reads them with a lag).
   std::vector<sensors::BeliefHistory> belief_history(n);
+  sensors::IdentityEvidence identity_evidence;  // gnss_ingest's: RFID reads and failed reads per picker
   std::vector<sensors::GnssIngest*> ingests;
   for (auto& t : tracks) ingests.push_back(t.gnss.get());
   sensors::RfidObservationModel rfid_model(
@@ -462,9 +463,13 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         const sensors::RfidResult r = rfid_model.process(read);
         if (r.observation) {
           if (sensors::addIdentifyingSighting(*r.observation, ingests)) ++result.bias_sightings;
+          identity_evidence.add(*r.observation, gnss_options.association);
           toTracker(*r.observation);
         }
-        for (const auto& neg : r.negative) toTracker(neg);
+        for (const auto& neg : r.negative) {
+          identity_evidence.add(neg, gnss_options.association);
+          toTracker(neg);
+        }
       } else {
 #ifdef PL_HAVE_VISION
         const sim::LaserScan& s = out.scans[e.index];
@@ -488,9 +493,9 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
             sensors::beliefViews(belief_history, s.stamp, gnss_options.association);
         std::vector<Eigen::Vector2d> people;
         for (const auto& t : tracked) {
-          const sensors::AssociationResult a = sensors::associatePerson(
-              sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id), ingests, beliefs, *map,
-              gnss_options.association);
+          const sensors::AssociationResult a =
+              sensors::associatePerson(sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id),
+                                       ingests, beliefs, *map, gnss_options.association, &identity_evidence);
           if (a.picker >= 0) {
             ++result.identified_detections;
             std::size_t nearest = 0;

@@ -97,7 +97,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
     subs_.push_back(nh.subscribe<geometry_msgs::PoseArray>(
         t, 20, [this, t](const geometry_msgs::PoseArray::ConstPtr& m) { onPeoplePoses(m, t); }));
   followPoseTopics(registry.ids());
-  if (!o.bias.sighting_sensors.empty())
+  if (!o.bias.sighting_sensors.empty() || (o.association.enabled && !o.association.identity_sensors.empty()))
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onIdentified(m); }));
   if (ordering_latency_ > 0.0)
@@ -252,19 +252,25 @@ void GnssIngestNode::acceptPerson(core::Observation person, const std::string& k
 
 void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
   // Cheap filter before converting: this topic carries every observation of the fleet.
-  if (!msg->identifying || !options_.bias.isSightingSensor(msg->sensor)) return;
+  const bool evidence = options_.association.enabled && options_.association.isIdentitySensor(msg->sensor);
+  if (!msg->identifying || !(evidence || options_.bias.isSightingSensor(msg->sensor))) return;
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;
   Input in;
   in.is_fix = false;
   in.is_sighting = true;
   in.person = fromMsg(*msg, *map_);
-  if (!in.person.position) return;
+  if (!in.person.position && !evidence) return;
   if (ordering_latency_ <= 0.0) {
-    sensors::addIdentifyingSighting(in.person, pickerPointers());
+    useIdentified(in.person);
     return;
   }
   ordering_.push(in.person.stamp, "sighting|" + msg->sensor + "|" + msg->picker_id + "|" + msg->robot_id, std::move(in));
+}
+
+void GnssIngestNode::useIdentified(const core::Observation& obs) {
+  if (options_.association.enabled) identity_.add(obs, options_.association);
+  if (obs.position) sensors::addIdentifyingSighting(obs, pickerPointers());
 }
 
 void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
@@ -288,7 +294,7 @@ void GnssIngestNode::releaseOrdered() {
       const auto it = by_id_.find(item.second.picker);
       if (it != by_id_.end()) processFix(*it->second, item.second.fix);
     } else if (item.second.is_sighting) {
-      sensors::addIdentifyingSighting(item.second.person, pickerPointers());
+      useIdentified(item.second.person);
     } else {
       processPerson(item.second.person);
     }
@@ -389,8 +395,8 @@ void GnssIngestNode::processFix(Picker& picker, const sensors::GnssFix& fix) {
 void GnssIngestNode::processPerson(const core::Observation& person) {
   ++people_;
   const sensors::AssociationResult a = sensors::associatePerson(
-      person, pickerPointers(), sensors::beliefViews(beliefHistories(), person.stamp, options_.association), *map_,
-      options_.association);
+      person, pickerPointers(), sensors::beliefViews(beliefHistories(), person.stamp, options_.association),
+      *map_, options_.association, &identity_);
   if (a.picker >= 0) {
     ++identified_;
     if (!a.bias.accepted)

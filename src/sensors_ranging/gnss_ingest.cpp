@@ -90,17 +90,28 @@ PickerAssociationOptions PickerAssociationOptions::fromYaml(const YAML::Node& y)
   core::readOption(y, c, "association_max_belief_age", o.max_belief_age);
   core::readOption(y, c, "association_belief_lag", o.belief_lag);
   core::readOption(y, c, "association_min_candidate_probability", o.min_candidate_probability);
+  core::readOption(y, c, "association_identity_sensors", o.identity_sensors);
+  core::readOption(y, c, "association_identity_window", o.identity_window);
+  core::readOption(y, c, "association_identity_floor", o.identity_floor);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
   return o;
 }
 
 const std::vector<std::string>& PickerAssociationOptions::yamlKeys() {
-  static const std::vector<std::string> keys = {
-      "associate_people",         "association_clutter_density", "association_min_probability",
-      "association_belief_weight", "association_belief_sigma",   "association_max_fix_age",
-      "association_speed",        "association_max_belief_age",  "association_belief_lag",
-      "association_min_candidate_probability"};
+  static const std::vector<std::string> keys = {"associate_people",
+                                                "association_clutter_density",
+                                                "association_min_probability",
+                                                "association_belief_weight",
+                                                "association_belief_sigma",
+                                                "association_max_fix_age",
+                                                "association_speed",
+                                                "association_max_belief_age",
+                                                "association_belief_lag",
+                                                "association_min_candidate_probability",
+                                                "association_identity_sensors",
+                                                "association_identity_window",
+                                                "association_identity_floor"};
   return keys;
 }
 
@@ -120,7 +131,17 @@ std::string PickerAssociationOptions::validate() const {
   if (!(speed >= 0.0) || !std::isfinite(speed)) return bad("association_speed", speed, "finite and >= 0");
   if (!(max_belief_age > 0.0)) return bad("association_max_belief_age", max_belief_age, "> 0");
   if (!(belief_lag >= 0.0) || !std::isfinite(belief_lag)) return bad("association_belief_lag", belief_lag, "finite and >= 0");
+  if (!(identity_window > 0.0) || !std::isfinite(identity_window))
+    return bad("association_identity_window", identity_window, "finite and > 0");
+  if (!(identity_floor > 0.0 && identity_floor <= 1.0))
+    return bad("association_identity_floor", identity_floor, "in (0, 1]");
   return "";
+}
+
+bool PickerAssociationOptions::isIdentitySensor(const std::string& sensor) const {
+  for (const std::string& s : identity_sensors)
+    if (s == sensor) return true;
+  return false;
 }
 
 const char* toString(GnssRejection r) {

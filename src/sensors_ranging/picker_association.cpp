@@ -1,7 +1,9 @@
 #include "picker_localisation/sensors_ranging/picker_association.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 
 namespace picker_localisation {
@@ -61,9 +63,63 @@ std::vector<BeliefView> beliefViews(const std::vector<const BeliefHistory*>& his
   return views;
 }
 
+bool IdentityEvidence::add(const core::Observation& obs, const PickerAssociationOptions& o) {
+  if (!obs.identifying || obs.picker_id.empty() || !o.isIdentitySensor(obs.sensor) || obs.nodes.empty() ||
+      obs.nodes.size() != obs.likelihood.size() || !std::isfinite(obs.stamp))
+    return false;
+  Item& item = items_[obs.picker_id][obs.sensor + "|" + obs.robot_id];
+  if (!item.likelihood.empty() && obs.stamp < item.stamp) return false;
+  item.stamp = obs.stamp;
+  item.likelihood.clear();
+  item.likelihood.reserve(obs.nodes.size());
+  for (std::size_t k = 0; k < obs.nodes.size(); ++k)
+    if (std::isfinite(obs.likelihood[k]) && obs.likelihood[k] >= 0.0)
+      item.likelihood[obs.nodes[k]] = obs.likelihood[k];
+  return true;
+}
+
+double IdentityEvidence::ratio(const std::string& picker_id, double t, const Eigen::Vector2d& z,
+                               const Eigen::Vector2d& mean, const Eigen::Matrix2d& covariance,
+                               const topology::TopologicalMap& map, const PickerAssociationOptions& o) const {
+  const auto picker = items_.find(picker_id);
+  if (picker == items_.end()) return 1.0;
+  const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (covariance + covariance.transpose()));
+  if (llt.info() != Eigen::Success) return 1.0;
+  const Eigen::Matrix2d root = llt.matrixL();
+  // 3-point Gauss-Hermite rule per axis (nodes 0, +-sqrt(3) sigma; weights 2/3, 1/6, 1/6): exact for a
+  // polynomial of degree 5 in each axis.
+  static const double kNode[3] = {0.0, std::sqrt(3.0), -std::sqrt(3.0)};
+  static const double kWeight[3] = {2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0};
+  topology::NodeIndex points[9];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      points[3 * a + b] = map.nearestNode(mean + root * Eigen::Vector2d(kNode[a], kNode[b]));
+  const topology::NodeIndex at_detection = map.nearestNode(z);
+  double rho = 1.0;
+  for (const auto& entry : picker->second) {
+    const Item& item = entry.second;
+    if (std::abs(t - item.stamp) > o.identity_window) continue;
+    auto value = [&item](topology::NodeIndex n) {
+      const auto it = item.likelihood.find(n);
+      return it == item.likelihood.end() ? 0.0 : it->second;
+    };
+    double expected = 0.0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) expected += kWeight[a] * kWeight[b] * value(points[3 * a + b]);
+    rho *= std::max(value(at_detection), o.identity_floor) / std::max(expected, o.identity_floor);
+  }
+  return rho;
+}
+
+std::size_t IdentityEvidence::size() const {
+  std::size_t n = 0;
+  for (const auto& p : items_) n += p.second.size();
+  return n;
+}
+
 AssociationResult associatePerson(const core::Observation& person, const std::vector<GnssIngest*>& pickers,
                                   const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
-                                  const PickerAssociationOptions& o) {
+                                  const PickerAssociationOptions& o, const IdentityEvidence* evidence) {
   AssociationResult r;
   r.observation = person;
   r.probabilities.assign(pickers.size(), 0.0);
@@ -84,6 +140,8 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
       l[i] = (1.0 - o.belief_weight) * g + o.belief_weight * b;
     else
       l[i] = fix.valid ? g : b;
+    if (evidence && fix.valid)
+      l[i] *= evidence->ratio(pickers[i]->pickerId(), person.stamp, z, fix.mean, fix.covariance + R, map, o);
     total += l[i];
   }
   const double norm = o.clutter_density + total;

@@ -130,6 +130,9 @@ class GnssIngestNode {
   void acceptPerson(core::Observation person, const std::string& key);
   bool inMapFrame(const std::string& frame, const char* what);
   void onIdentified(const picker_localisation::Observation::ConstPtr& msg);
+  // An identifying observation of the fleet: a bias sighting (bias_sighting_sensors) and / or identity
+  // evidence for the association (association_identity_sensors).
+  void useIdentified(const core::Observation& obs);
   void onBelief(const picker_localisation::PickerBelief& msg);
   bool checkClock();
   std::vector<sensors::GnssIngest*> pickerPointers();
@@ -146,6 +149,7 @@ class GnssIngestNode {
   std::unique_ptr<sensors::GeodeticDatum> datum_;
   std::string frame_id_, bias_prefix_;
   sensors::GnssIngestOptions options_;
+  sensors::IdentityEvidence identity_;  // RFID reads / failed reads per picker (association_identity_sensors)
   std::vector<std::unique_ptr<Picker>> pickers_;  // in the order of the list
   std::unordered_map<std::string, Picker*> by_id_;
   std::vector<ros::Subscriber> subs_;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/sensors_ranging/geodetic_datum.h"
@@ -62,6 +63,15 @@ struct PickerAssociationOptions {
   double belief_lag = 2.0;           // s, the belief used is the newest one stamped at least this long before
                                      // the detection (>= the trackers' ordering latency: deterministic replay)
   double max_belief_age = 10.0;      // s, an older belief (beyond the lag) is not used
+  // Identity evidence (picker_association.h, IdentityEvidence): the newest identifying observation of each of
+  // these sensors per picker and robot (an RFID read, the failed reads of an antenna that is reading, a UWB
+  // range) weighs "this detection is picker i" by how much better it explains that observation than the
+  // picker's predicted position does. Empty: not used.
+  std::vector<std::string> identity_sensors{"rfid", "uwb"};
+  double identity_window = 5.0;  // s, evidence older (or newer) than this around the detection is not used
+  double identity_floor = 0.02;  // floor on both sides of the ratio: one observation changes l_i by at
+                                 // most 1 / floor either way
+  bool isIdentitySensor(const std::string& sensor) const;
 
   static PickerAssociationOptions fromYaml(const YAML::Node& node);
   static const std::vector<std::string>& yamlKeys();
