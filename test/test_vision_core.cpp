@@ -297,3 +297,40 @@ TEST(HogPersonDetector, TinyAndOddImagesGiveNoBoxesAndNoCrash) {
   // A frame of the window size is processed (whatever it finds).
   EXPECT_NO_THROW(hog.detect(cv::Mat(128, 64, CV_8UC3, cv::Scalar::all(128))));
 }
+
+// The ONNX path through cv::dnn, with models generated at build time by test/make_test_onnx.py
+// (python3-onnx): person_ssd.onnx outputs a person row whose score is the mean of the input blob, box (0.1,
+// 0.2)-(0.4, 0.9) of the image, and a row of another class; wrong_shape.onnx outputs [1 x 1 x 1 x 5].
+TEST(OnnxPersonDetector, GeneratedModelGivesItsBoxAndAWrongShapeIsRefused) {
+  OnnxOptions o;
+  o.model_path = std::string(PL_TEST_ONNX_DIR) + "/person_ssd.onnx";
+  const OnnxPersonDetector onnx(o);  // 300 x 300 input, blob = (pixel - 127.5) / 127.5, person class 1
+  const cv::Mat bright(480, 640, CV_8UC3, cv::Scalar::all(230));
+  const std::vector<PersonBox> boxes = onnx.detect(bright);
+  ASSERT_EQ(boxes.size(), 1u);  // the class-2 row (score 0.99) is not a person
+  EXPECT_EQ(boxes[0].box,
+            cv::Rect(cv::Point(64, 96), cv::Point(256, 432)));  // 0.1..0.4 x 640, 0.2..0.9 x 480
+  // cv::dnn's ReduceMean gives 0.8015 for the exact 0.8039; a wrong mean, scale or channel order would be far
+  // off.
+  EXPECT_NEAR(boxes[0].confidence, (230.0 - 127.5) / 127.5, 0.01);
+  // A dark image: blob mean (40 - 127.5) / 127.5 < 0: below min_confidence 0.5, nothing.
+  EXPECT_TRUE(onnx.detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(40))).empty());
+  o.min_confidence = 0.9;  // 0.80 is not enough
+  EXPECT_TRUE(OnnxPersonDetector(o).detect(bright).empty());
+
+  auto refusal = [](const OnnxOptions& options) {
+    try {
+      OnnxPersonDetector d(options);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  OnnxOptions wrong;
+  wrong.model_path = std::string(PL_TEST_ONNX_DIR) + "/wrong_shape.onnx";
+  EXPECT_NE(refusal(wrong).find("outputs [1 x 1 x 1 x 5], expected rows of 7"), std::string::npos)
+      << refusal(wrong);
+  OnnxOptions missing;
+  missing.model_path = std::string(PL_TEST_ONNX_DIR) + "/no_such_model.onnx";
+  EXPECT_NE(refusal(missing).find("cannot read"), std::string::npos) << refusal(missing);
+}

@@ -92,6 +92,30 @@ OnnxPersonDetector::OnnxPersonDetector(OnnxOptions options) : options_(std::move
     throw std::runtime_error("OnnxPersonDetector: cannot read " + options_.model_path + ": " + e.what());
   }
   if (impl_->net.empty()) throw std::runtime_error("OnnxPersonDetector: empty network " + options_.model_path);
+  // One pass on a grey image now, so a model of the wrong input size or output layout fails at start-up with
+  // its shape named, not at the first camera frame.
+  cv::Mat result;
+  try {
+    impl_->net.setInput(cv::Mat(std::vector<int>{1, 3, options_.input_height, options_.input_width}, CV_32F,
+                                cv::Scalar(0.0)));
+    result = impl_->net.forward();
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("OnnxPersonDetector: " + options_.model_path + " does not run on a 1 x 3 x " +
+                             std::to_string(options_.input_height) + " x " +
+                             std::to_string(options_.input_width) +
+                             " input (onnx_input_height / onnx_input_width): " + e.what());
+  }
+  checkOutputShape(result);
+}
+
+void OnnxPersonDetector::checkOutputShape(const cv::Mat& result) const {
+  if (result.dims >= 2 && result.size[result.dims - 1] == 7) return;
+  std::string shape;
+  for (int d = 0; d < result.dims; ++d) shape += (d ? " x " : "") + std::to_string(result.size[d]);
+  throw std::runtime_error(
+      "OnnxPersonDetector: " + options_.model_path + " outputs [" + shape +
+      "], expected rows of 7 (image, class, score, x1, y1, x2, y2), e.g. [1 x 1 x N x 7] as "
+      "OpenCV's DetectionOutput layer (an SSD export)");
 }
 
 std::vector<PersonBox> OnnxPersonDetector::detect(const cv::Mat& bgr) const {
@@ -106,7 +130,7 @@ std::vector<PersonBox> OnnxPersonDetector::detect(const cv::Mat& bgr) const {
     impl_->net.setInput(blob);
     result = impl_->net.forward();
   }
-  if (result.total() % 7 != 0) throw std::runtime_error("OnnxPersonDetector: output is not N x 7 rows");
+  checkOutputShape(result);
   const cv::Mat rows(static_cast<int>(result.total() / 7), 7, CV_32F, result.ptr<float>());
   for (int i = 0; i < rows.rows; ++i) {
     const float* r = rows.ptr<float>(i);
