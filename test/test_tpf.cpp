@@ -693,6 +693,7 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.lane_change_model, d.lane_change_model);
   EXPECT_EQ(p.lane_change_leak, d.lane_change_leak);
   EXPECT_EQ(p.lane_change_max_hops, d.lane_change_max_hops);
+  EXPECT_EQ(p.lane_change_keep_side, d.lane_change_keep_side);
   EXPECT_EQ(p.jsd_monitor, d.jsd_monitor);
   EXPECT_EQ(p.reinit_fraction, d.reinit_fraction);
 }
@@ -985,6 +986,43 @@ TEST(TpfLaneChange, ParticlesLeavingALaneEndWalkIntoTheAdjacentLane) {
   EXPECT_GT(with.first, 0.3);   // many particles left the lane
   EXPECT_GT(with.second, 0.8);  // ... and most of them are in lane 4 or 6
   EXPECT_LT(without.second, with.second - 0.2);
+}
+
+// Side memory: particles leave lane 5 at its near end into lane 4 or 6 (no memory yet: either side), walk
+// that lane to its far end and leave it again. With lane_change_keep_side 0.8 most carry on the same way (6
+// -> 7, 4 -> 3); with 0.5 (no memory) they go back to lane 5 as often as on.
+TEST(TpfLaneChange, ParticlesRememberTheSideOfTheirLastLaneChange) {
+  auto map = polytunnel();
+  const NodeIndex start = *map->index("r5_0");
+  auto carry_on_share = [&](double keep, std::size_t* changed) {
+    TpfParams p;  // product defaults
+    p.num_particles = 4000;
+    p.lane_change_keep_side = keep;
+    p.reverse_rate = 0.0;
+    p.velocity_init_mean = -0.6;  // first jump to H5, as in the test above
+    p.velocity_init_variance = 0.0;
+    p.dwell_init_max = 0.0;
+    p.unconnected_jump_probability = 0.0;
+    TopologicalParticleFilter f(map, p, 11);
+    EXPECT_TRUE(f.update(obsAt(0.0, {start}, {1.0})).ok());
+    for (int k = 1; k <= 40; ++k) f.predictTo(k);  // two lane changes: ~34 m at ~0.85 m/s
+    std::size_t on = 0, back = 0;
+    for (const auto& q : f.particles()) {
+      const auto lane = map->lane(q.node);
+      if (lane < 0 || q.last_lane_change == 0) continue;  // on a headland, or never completed a lane change
+      const std::string name = map->laneName(lane);
+      if (name == "row_3" || name == "row_7") ++on;
+      if (name == "row_5") ++back;
+    }
+    *changed = on + back;
+    return on + back ? static_cast<double>(on) / static_cast<double>(on + back) : 0.0;
+  };
+  std::size_t changed_keep = 0, changed_none = 0;
+  const double keep = carry_on_share(0.8, &changed_keep), none = carry_on_share(0.5, &changed_none);
+  EXPECT_GT(changed_keep, 1000u);  // most have made both lane changes in 40 s
+  EXPECT_GT(changed_none, 1000u);
+  EXPECT_GT(keep, 0.75) << keep;  // measured 0.81 (0.49 without memory)
+  EXPECT_NEAR(none, 0.5, 0.1) << none;
 }
 
 TEST(TpfLaneChange, VelocityFollowsTheEdgeAndParticlesReverse) {

@@ -76,6 +76,7 @@ struct TopologicalParticleFilter::MotionGraph {
   // Lane-change paths (TpfParams::lane_change_model): lane end, non-lane nodes..., adjacent lane's end, its
   // next lane node; exits of node n are exit_paths[exit_offsets[n] .. exit_offsets[n + 1]).
   std::vector<std::vector<NodeIndex>> lane_paths;
+  std::vector<Eigen::Vector2d> lane_path_shift;  // adjacent lane's end minus the lane end left, m
   std::vector<std::uint32_t> exit_offsets, exit_paths;
 
   void buildLaneChangePaths(const topology::TopologicalMap& map, bool directed, int max_hops) {
@@ -140,6 +141,9 @@ struct TopologicalParticleFilter::MotionGraph {
               break;
             }
           exits[e].push_back(static_cast<std::uint32_t>(lane_paths.size()));
+          // From lane end to the adjacent lane's end (not to the path's last node, one node along the new
+          // lane: along-lane steps would swamp the 1.5 m sideways shift in the dot products of sideWeight).
+          lane_path_shift.push_back(map.position2d(path[path.size() - 2]) - map.position2d(path.front()));
           lane_paths.push_back(std::move(path));
         }
         for (NodeIndex k : visited) depth[k] = -1;
@@ -152,16 +156,47 @@ struct TopologicalParticleFilter::MotionGraph {
     }
   }
 
+  // Side memory (TpfParams::lane_change_keep_side): weight of lane-change path `path` for a particle whose
+  // last completed lane change was `last` (1 + index; 0: none): keep when both shift the same way, 1 - keep
+  // when they shift opposite ways, 0.5 when there is no memory or the shifts are perpendicular.
+  double sideWeight(std::uint32_t path, std::uint32_t last, double keep) const {
+    if (last == 0) return 0.5;
+    const double dot = lane_path_shift[path].dot(lane_path_shift[last - 1]);
+    return dot > 0.0 ? keep : (dot < 0.0 ? 1.0 - keep : 0.5);
+  }
+  // Factor on the jump from `from` to `to` at a turn: twice the mean side weight of the lane-change paths of
+  // `from` starting with that jump (1 when none: the back edge, or a node both sides share equally).
+  double exitWeight(NodeIndex from, NodeIndex to, std::uint32_t last, double keep) const {
+    if (exit_offsets.empty() || last == 0) return 1.0;
+    double sum = 0.0;
+    int count = 0;
+    for (std::uint32_t k = exit_offsets[from]; k < exit_offsets[from + 1]; ++k)
+      if (lane_paths[exit_paths[k]][1] == to) sum += sideWeight(exit_paths[k], last, keep), ++count;
+    return count ? 2.0 * sum / count : 1.0;
+  }
+
   // A particle jumped from `from` to `to`, leaving its lane: 1 + the index of a lane-change path of `from`
-  // whose first step is that jump (the jump chose the side; when both sides share the first node, one at
-  // random), or 0 when there is none or the path already ends at `to`.
-  std::uint32_t exitPathStartingWith(NodeIndex from, NodeIndex to, std::mt19937_64& rng) const {
+  // whose first step is that jump (the jump chose the side; when both sides share the first node, one drawn
+  // by side weight: at random without a memory), or 0 when there is none or the path already ends at `to`.
+  std::uint32_t exitPathStartingWith(NodeIndex from, NodeIndex to, std::mt19937_64& rng, std::uint32_t last,
+                                     double keep) const {
     if (exit_offsets.empty()) return 0;
     const std::uint32_t begin = exit_offsets[from], end = exit_offsets[from + 1];
     auto starts_with_to = [&](std::uint32_t k) { return lane_paths[exit_paths[k]][1] == to; };
     std::uint32_t found = 0;
     for (std::uint32_t k = begin; k < end; ++k) found += starts_with_to(k) ? 1 : 0;
     if (found == 0) return 0;
+    if (found > 1 && last != 0 && keep != 0.5) {
+      double total = 0.0;
+      for (std::uint32_t k = begin; k < end; ++k)
+        if (starts_with_to(k)) total += sideWeight(exit_paths[k], last, keep);
+      double u = static_cast<double>(rng() >> 11) * 0x1.0p-53 * total;
+      for (std::uint32_t k = begin; k < end; ++k) {
+        if (!starts_with_to(k)) continue;
+        u -= sideWeight(exit_paths[k], last, keep);
+        if (u < 0.0) return lane_paths[exit_paths[k]].back() == to ? 0 : exit_paths[k] + 1;
+      }
+    }
     std::uint32_t skip = found > 1 ? static_cast<std::uint32_t>(rng() % found) : 0;
     for (std::uint32_t k = begin; k < end; ++k)
       if (starts_with_to(k) && skip-- == 0)
@@ -465,6 +500,7 @@ void TopologicalParticleFilter::redraw(const core::Observation& obs, std::size_t
     p.vy = static_cast<float>(vel(rng_));
     p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
     p.lane_change = 0;
+    p.last_lane_change = 0;
     p.bias_variance = -1.0f;  // the bias starts from the next GNSS fix's prior
   }
   unconnected_p_ = params_.unconnected_jump_probability;
@@ -522,6 +558,7 @@ void TopologicalParticleFilter::predict(double dt) {
   const double turn_fraction = params_.turn_projection_fraction;
   const bool follow_edge = params_.velocity_follows_edge;
   const double leak = params_.lane_change_leak;
+  const double keep = params_.lane_change_keep_side;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
     const double tau0 = static_cast<double>(p.dwell), tau = tau0 + dt;
@@ -561,6 +598,10 @@ void TopologicalParticleFilter::predict(double dt) {
     if (path_next == topology::kInvalidNode && max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
       const double speed = std::sqrt(vx * vx + vy * vy);
       for (std::uint32_t e = begin; e < end; ++e) proj[e - begin] = g.arcs[e].length > 0.0 ? speed : 0.0;
+      if (p.last_lane_change != 0 && keep != 0.5)  // side memory: the remembered side's exit weighs more
+        for (std::uint32_t e = begin; e < end; ++e)
+          if (proj[e - begin] > 0.0)
+            proj[e - begin] *= g.exitWeight(p.node, g.arcs[e].target, p.last_lane_change, keep);
     }
     double sum_b = 0.0, sum_c = 0.0, denom = 0.0;
     for (std::uint32_t e = begin; e < end; ++e) {
@@ -612,9 +653,11 @@ void TopologicalParticleFilter::predict(double dt) {
       if (path_next != topology::kInvalidNode) {
         // Followed the path (ends one node inside the new lane) or left it.
         const auto& path = g.lane_paths[p.lane_change - 1];
+        if (arc.target == path_next && path.back() == arc.target) p.last_lane_change = p.lane_change;
         if (arc.target != path_next || path.back() == arc.target) p.lane_change = 0;
       } else if (map_->lane(arc.target) != map_->lane(from)) {
-        p.lane_change = g.exitPathStartingWith(from, arc.target, rng_);  // left the lane at an end?
+        // Left the lane at an end?
+        p.lane_change = g.exitPathStartingWith(from, arc.target, rng_, p.last_lane_change, keep);
       }
     }
     if (count[p.node] == 0.0) touched_.push_back(p.node);

@@ -57,6 +57,8 @@ std::string TpfParams::validate() const {
   if (!(reinit_fraction > 0.0 && reinit_fraction <= 1.0)) return "reinit_fraction must be in (0, 1]";
   if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0)) return "lane_change_leak must be in [0, 1]";
   if (lane_change_max_hops < 1) return "lane_change_max_hops must be >= 1";
+  if (!(lane_change_keep_side >= 0.0 && lane_change_keep_side <= 1.0))
+    return "lane_change_keep_side must be in [0, 1]";
   if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate)) return "reverse_rate must be finite and >= 0";
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
     return "turn_projection_fraction must be in [0, 1]";
@@ -170,6 +172,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   read(node, "lane_change_model", p.lane_change_model);
   read(node, "lane_change_leak", p.lane_change_leak);
   read(node, "lane_change_max_hops", p.lane_change_max_hops);
+  read(node, "lane_change_keep_side", p.lane_change_keep_side);
   read(node, "accepted_sensors", p.accepted_sensors);
   read(node, "jsd_monitor", p.jsd_monitor);
   read(node, "jsd_threshold", p.jsd_threshold);

@@ -69,13 +69,15 @@ namespace picker_localisation {
 namespace tpf {
 
 // One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter), plus the lane-change path
-// index and the GNSS bias state (TpfParams::gnss_bias_state): 32 bytes. Single precision is ample for speeds
+// index, the last lane change completed (TpfParams::lane_change_keep_side) and the GNSS bias state
+// (TpfParams::gnss_bias_state): 36 bytes. Single precision is ample for speeds
 // (m/s), dwell times (s) and biases (m) and halves the memory traffic of resampling.
 struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
   float dwell = 0.0f;                                 // tau, s
   std::uint32_t lane_change = 0;  // 1 + index of the lane-change path being walked (0: none); see TpfParams
+  std::uint32_t last_lane_change = 0;  // 1 + index of the last lane-change path completed (0: none yet)
   float bias_x = 0.0f, bias_y = 0.0f;  // GNSS device bias b given this particle's path, m, map frame
   float bias_variance = -1.0f;         // per-axis variance of b, m^2; < 0: not started (next GNSS prior)
 };

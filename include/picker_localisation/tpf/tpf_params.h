@@ -83,6 +83,13 @@ struct TpfParams {
   bool lane_change_model = true;
   double lane_change_leak = 0.1;  // relative weight of the edges off the path, [0, 1]
   int lane_change_max_hops = 6;   // longest lane-change path searched, hops
+  // Side memory (not in the paper): pickers work through a tunnel row after row in one direction, so a picker
+  // that last moved to the lane on one side will likely move on to that side again. Each particle remembers
+  // the direction of its last completed lane change; at a lane end, a side whose path agrees with it
+  // (positive dot product of the two displacements) weighs lane_change_keep_side against 1 -
+  // lane_change_keep_side for the other side (the back edge into the lane keeps its weight). 0.5: no memory,
+  // each side equally likely.
+  double lane_change_keep_side = 0.8;
 
   // --- GNSS bias per particle (not in the paper; Khan et al., seed 001 Sec. VI) ----------------------------
   // A phone's fix is wrong by an almost constant 2-5 m: its errors are one slowly drifting bias, not
