@@ -11,23 +11,17 @@
 #include <cmath>
 #include <functional>
 
-#include "vision_rostest_util.h"
+#include "camera_rostest_util.h"
 
 using vision_test::waitFor;
 
-namespace {
-
-std::vector<picker_localisation::BearingDetectionArray> received;
-void onDetections(const picker_localisation::BearingDetectionArray::ConstPtr& m) { received.push_back(*m); }
-
-}  // namespace
-
 TEST(CameraDetectorNode, BearingsStaleFramesRateAndMissingInfo) {
   ros::NodeHandle nh;
-  auto sub = nh.subscribe("detections", 10, onDetections);
-  auto image_pub = nh.advertise<sensor_msgs::Image>("image", 5);
-  auto info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
-  ASSERT_TRUE(waitFor([&] { return image_pub.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 30.0));
+  vision_test::CameraDetectorRig rig(nh);
+  ASSERT_TRUE(rig.connected(30.0));
+  auto& received = rig.received;
+  auto& image_pub = rig.image_pub;
+  auto& info_pub = rig.info_pub;
 
   cv::VideoCapture cap("/usr/share/doc/opencv-doc/examples/data/vtest.avi");
   cv::Mat frame;
@@ -53,7 +47,7 @@ TEST(CameraDetectorNode, BearingsStaleFramesRateAndMissingInfo) {
 
   const ros::Time t0 = ros::Time::now();
   image_pub.publish(image(t0));
-  ASSERT_TRUE(waitFor([] { return received.size() == 1; }, 20.0));
+  ASSERT_TRUE(waitFor([&] { return received.size() == 1; }, 20.0));
   const auto& a = received[0];
   EXPECT_EQ(a.header.stamp, t0);
   EXPECT_EQ(a.header.frame_id, "camera");

@@ -9,27 +9,19 @@
 
 #include <cmath>
 
-#include "vision_rostest_util.h"
+#include "camera_rostest_util.h"
 
 using vision_test::waitFor;
 
-namespace {
-std::vector<picker_localisation::BearingDetectionArray> received;
-void onDetections(const picker_localisation::BearingDetectionArray::ConstPtr& m) { received.push_back(*m); }
-}  // namespace
-
 TEST(CameraDetectorOnnx, TheModelsBoxComesOutWithItsBearing) {
   ros::NodeHandle nh;
-  auto sub = nh.subscribe("detections", 10, onDetections);
-  auto image_pub = nh.advertise<sensor_msgs::Image>("image", 5);
-  auto info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
-  ASSERT_TRUE(waitFor([&] { return image_pub.getNumSubscribers() > 0 && sub.getNumPublishers() > 0; }, 30.0))
-      << "camera_detector did not start with the generated model";
+  vision_test::CameraDetectorRig rig(nh);
+  ASSERT_TRUE(rig.connected(30.0)) << "camera_detector did not start with the generated model";
   sensor_msgs::CameraInfo info;
   info.width = 640;
   info.height = 480;
   info.K = {500.0, 0.0, 320.0, 0.0, 500.0, 240.0, 0.0, 0.0, 1.0};
-  info_pub.publish(info);
+  rig.info_pub.publish(info);
   waitFor([] { return false; }, 0.5);
   auto frame = [](int value) {
     std_msgs::Header h;
@@ -37,19 +29,20 @@ TEST(CameraDetectorOnnx, TheModelsBoxComesOutWithItsBearing) {
     h.frame_id = "camera_optical";
     return cv_bridge::CvImage(h, "bgr8", cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(value))).toImageMsg();
   };
-  image_pub.publish(frame(230));
-  ASSERT_TRUE(waitFor([] { return received.size() == 1; }, 20.0));
-  ASSERT_EQ(received[0].detections.size(), 1u);
-  const auto& d = received[0].detections[0];
+  rig.image_pub.publish(frame(230));
+  ASSERT_TRUE(rig.receivedAtLeast(1, 20.0));
+  ASSERT_EQ(rig.received[0].detections.size(), 1u);
+  const auto& d = rig.received[0].detections[0];
   EXPECT_EQ(d.box.x_offset, 64u);  // 0.1 x 640
   EXPECT_EQ(d.box.y_offset, 96u);  // 0.2 x 480
   EXPECT_EQ(d.box.width, 192u);    // (0.4 - 0.1) x 640
   EXPECT_EQ(d.box.height, 336u);   // (0.9 - 0.2) x 480
   EXPECT_NEAR(d.confidence, (230.0 - 127.5) / 127.5, 0.01);  // cv::dnn's ReduceMean: 0.8015
   EXPECT_NEAR(d.bearing, std::atan((320.0 - 160.0) / 500.0), 1e-9);  // centre column 160, left of the axis
-  image_pub.publish(frame(40));
-  ASSERT_TRUE(waitFor([] { return received.size() == 2; }, 20.0));
-  EXPECT_TRUE(received[1].detections.empty());
+  rig.image_pub.publish(frame(40));
+  ASSERT_TRUE(rig.receivedAtLeast(2, 20.0));
+  EXPECT_EQ(rig.received.size(), 2u);
+  EXPECT_TRUE(rig.received[1].detections.empty());
 }
 
 int main(int argc, char** argv) {

@@ -6,8 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <iomanip>
+#include <iostream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <ostream>
@@ -351,7 +352,12 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   double prediction_period = 4.0;
   if (spec.tracker == Tracker::kTpf) {
     const std::string tpf_file = resolveConfigFile(config.tpf_config, "tpf.yaml");
-    tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
+    std::vector<std::string> unknown;
+    tpf::TpfParams base =
+        tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file, &unknown);
+    static std::atomic<bool> warned{false};  // once per process, not once per run
+    if (!unknown.empty() && !warned.exchange(true))
+      for (const std::string& u : unknown) std::cerr << "experiment: " << tpf_file << ": " << u << "\n";
     const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
     prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
     for (std::size_t i = 0; i < n; ++i)

@@ -221,12 +221,15 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     }
     base_params_ = tpfYamlFromRos(pnh);
     // The pickers file's and picker_id's keys are this node's, not the filter's.
-    for (const char* own : {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id",
-                            "topic_prefix", "observations_topic", "ordering_latency", "max_future_stamp",
-                            "on_demand_topics_above", "demand_poll_period", "gnss_ingest",
-                            "map_timeout", "map_topic"})
+    for (const char* own :
+         {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id", "topic_prefix",
+          "observations_topic", "ordering_latency", "max_future_stamp", "on_demand_topics_above",
+          "demand_poll_period", "gnss_ingest", "map_timeout", "map_topic", "current_node_namespace"})
       base_params_.remove(own);
-    tpf::TpfParams::fromYaml(base_params_);  // a bad shared value is one FATAL line, not one per picker
+    // A bad shared value is one FATAL line, not one per picker; an unknown key (a typo) one warning.
+    std::vector<std::string> unknown;
+    tpf::TpfParams::fromYaml(base_params_, &unknown);
+    for (const std::string& u : unknown) ROS_WARN("tpf_tracker: %s", u.c_str());
   } catch (const std::exception& e) {
     ROS_FATAL("tpf_tracker: %s", e.what());
     return;

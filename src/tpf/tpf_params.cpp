@@ -1,5 +1,7 @@
 #include "picker_localisation/tpf/tpf_params.h"
 
+#include "picker_localisation/core/yaml_keys.h"
+
 #include "picker_localisation/core/yaml_file.h"
 
 #include <algorithm>
@@ -127,7 +129,54 @@ SensorGamma readGamma(const YAML::Node& node, const std::string& key) {
 
 }  // namespace
 
-TpfParams TpfParams::fromYaml(const YAML::Node& node) {
+const std::vector<std::string>& TpfParams::yamlKeys() {
+  static const std::vector<std::string> keys = {"num_particles",
+                                                "velocity_init_mean",
+                                                "velocity_init_variance",
+                                                "dwell_init_min",
+                                                "dwell_init_max",
+                                                "velocity_noise_mean",
+                                                "velocity_noise_variance",
+                                                "dwell_noise_min",
+                                                "dwell_noise_max",
+                                                "fixed_lambda",
+                                                "velocity_window",
+                                                "min_jump_dwell",
+                                                "directed_motion",
+                                                "step_consistent_jumps",
+                                                "turn_projection_fraction",
+                                                "gamma_as_confidence",
+                                                "min_velocity_sigma",
+                                                "velocity_weight_product",
+                                                "velocity_follows_edge",
+                                                "reverse_rate",
+                                                "lane_change_model",
+                                                "lane_change_leak",
+                                                "lane_change_max_hops",
+                                                "lane_change_keep_side",
+                                                "accepted_sensors",
+                                                "jsd_monitor",
+                                                "jsd_threshold",
+                                                "reinit_max_mean_likelihood",
+                                                "reinit_fraction",
+                                                "reinit_sensors",
+                                                "entropy_gate",
+                                                "entropy_threshold",
+                                                "unconnected_jump_probability",
+                                                "prediction_rate",
+                                                "reorder_window",
+                                                "gnss_bias_state",
+                                                "gnss_bias_sensors",
+                                                "gnss_bias_fix_std",
+                                                "resampling",
+                                                "motion_model",
+                                                "sensor_gammas",
+                                                "default_gamma",
+                                                "method"};
+  return keys;
+}
+
+TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* unknown) {
   TpfParams p;
   if (!node || node.IsNull()) return p;
   if (!node.IsMap()) throw std::runtime_error("tpf params: top level must be a map");
@@ -196,11 +245,13 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node) {
   }
   const std::string problem = p.validate();
   if (!problem.empty()) throw std::runtime_error("tpf params: " + problem);
+  if (unknown)
+    for (auto& m : core::unknownKeys(node, yamlKeys(), "tpf params")) unknown->push_back(std::move(m));
   return p;
 }
 
-TpfParams TpfParams::fromYamlFile(const std::string& path) {
-  return core::parseYamlFile(path, [](const YAML::Node& root) { return fromYaml(root); });
+TpfParams TpfParams::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [unknown](const YAML::Node& root) { return fromYaml(root, unknown); });
 }
 
 std::vector<std::string> TpfParams::methodNames() {

@@ -159,9 +159,11 @@ struct TpfParams {
 
   // Reads a YAML node with the keys of config/tpf.yaml (missing keys keep the defaults above; a `method`
   // key applies presetForMethod last, so the preset's mode switches win over the file's). Throws
-  // std::runtime_error naming the key on a bad value.
-  static TpfParams fromYaml(const YAML::Node& node);
-  static TpfParams fromYamlFile(const std::string& path);
+  // std::runtime_error naming the key on a bad value. With `unknown`, one message per key that is none of
+  // yamlKeys() is appended ("tpf params: unknown key 'x' (did you mean 'y'?)").
+  static TpfParams fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static TpfParams fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();  // every key fromYaml reads, `method` included
   // Table II method names: "tpf" (full filter, default), "paper_tpf" (the paper's filter read literally:
   // sets velocity_follows_edge, velocity_weight_product, reverse_rate, lane_change_model, jsd_monitor,
   // reinit_fraction to the paper's reading), "khan_connected", "khan_unconnected", "no_monitor",
