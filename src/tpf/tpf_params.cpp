@@ -45,44 +45,58 @@ bool TpfParams::usesBiasState(const std::string& sensor) const {
 
 std::string TpfParams::validate() const {
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
-  if (num_particles == 0) return "num_particles must be > 0";
+  if (num_particles == 0) return core::badValue("num_particles", static_cast<double>(num_particles), "> 0");
   if (!std::isfinite(velocity_init_mean) || !finite_nonneg(velocity_init_variance))
     return "velocity_init_mean / velocity_init_variance must be finite, variance >= 0";
   if (!std::isfinite(velocity_noise_mean) || !finite_nonneg(velocity_noise_variance))
     return "velocity_noise_mean / velocity_noise_variance must be finite, variance >= 0";
   if (!finite_nonneg(dwell_init_min) || !std::isfinite(dwell_init_max) || dwell_init_max < dwell_init_min)
-    return "dwell_init_min must be >= 0 and <= dwell_init_max";
+    return core::badValue("dwell_init_min", dwell_init_min, ">= 0 and <= dwell_init_max");
   if (!std::isfinite(dwell_noise_min) || !std::isfinite(dwell_noise_max) || dwell_noise_max < dwell_noise_min)
-    return "dwell_noise_min must be <= dwell_noise_max";
-  if (!finite_nonneg(fixed_lambda)) return "fixed_lambda must be >= 0";
-  if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window)) return "velocity_window must be >= 1";
-  if (!(reinit_fraction > 0.0 && reinit_fraction <= 1.0)) return "reinit_fraction must be in (0, 1]";
-  if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0)) return "lane_change_leak must be in [0, 1]";
-  if (lane_change_max_hops < 1) return "lane_change_max_hops must be >= 1";
+    return core::badValue("dwell_noise_min", static_cast<double>(dwell_noise_min), "<= dwell_noise_max");
+  if (!finite_nonneg(fixed_lambda))
+    return core::badValue("fixed_lambda", static_cast<double>(fixed_lambda), ">= 0");
+  if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window))
+    return core::badValue("velocity_window", static_cast<double>(velocity_window), ">= 1");
+  if (!(reinit_fraction > 0.0 && reinit_fraction <= 1.0))
+    return core::badValue("reinit_fraction", static_cast<double>(reinit_fraction), "in (0, 1]");
+  if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0))
+    return core::badValue("lane_change_leak", static_cast<double>(lane_change_leak), "in [0, 1]");
+  if (lane_change_max_hops < 1)
+    return core::badValue("lane_change_max_hops", static_cast<double>(lane_change_max_hops), ">= 1");
   if (!(lane_change_keep_side >= 0.0 && lane_change_keep_side <= 1.0))
-    return "lane_change_keep_side must be in [0, 1]";
-  if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate)) return "reverse_rate must be finite and >= 0";
+    return core::badValue("lane_change_keep_side", static_cast<double>(lane_change_keep_side), "in [0, 1]");
+  if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate))
+    return core::badValue("reverse_rate", static_cast<double>(reverse_rate), "finite and >= 0");
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
-    return "turn_projection_fraction must be in [0, 1]";
-  if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell)) return "min_jump_dwell must be > 0";
+    return core::badValue("turn_projection_fraction", static_cast<double>(turn_projection_fraction),
+                          "in [0, 1]");
+  if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell))
+    return core::badValue("min_jump_dwell", static_cast<double>(min_jump_dwell), "> 0");
   if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma))
-    return "min_velocity_sigma must be > 0";
+    return core::badValue("min_velocity_sigma", static_cast<double>(min_velocity_sigma), "> 0");
   for (const auto& [name, g] : sensor_gammas)
     if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity) || (gamma_as_confidence && g.node > 1.0))
       return "sensor_gammas." + name + " must be finite and >= 0 (node <= 1 with gamma_as_confidence)";
   if (!finite_nonneg(default_gamma.node) || !finite_nonneg(default_gamma.velocity) ||
       (gamma_as_confidence && default_gamma.node > 1.0))
     return "default_gamma must be finite and >= 0";
-  if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0)) return "jsd_threshold must be in [0, 1]";
+  if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0))
+    return core::badValue("jsd_threshold", static_cast<double>(jsd_threshold), "in [0, 1]");
   if (!(reinit_max_mean_likelihood > 0.0 && reinit_max_mean_likelihood <= 1.0))
-    return "reinit_max_mean_likelihood must be in (0, 1]";
-  if (!finite_nonneg(entropy_threshold)) return "entropy_threshold must be >= 0";
+    return core::badValue("reinit_max_mean_likelihood", static_cast<double>(reinit_max_mean_likelihood),
+                          "in (0, 1]");
+  if (!finite_nonneg(entropy_threshold))
+    return core::badValue("entropy_threshold", static_cast<double>(entropy_threshold), ">= 0");
   if (!(unconnected_jump_probability >= 0.0 && unconnected_jump_probability <= 1.0))
-    return "unconnected_jump_probability must be in [0, 1]";
-  if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate)) return "prediction_rate must be >= 0";
-  if (!finite_nonneg(reorder_window)) return "reorder_window must be >= 0";
+    return core::badValue("unconnected_jump_probability", static_cast<double>(unconnected_jump_probability),
+                          "in [0, 1]");
+  if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate))
+    return core::badValue("prediction_rate", static_cast<double>(prediction_rate), ">= 0");
+  if (!finite_nonneg(reorder_window))
+    return core::badValue("reorder_window", static_cast<double>(reorder_window), ">= 0");
   if (!(gnss_bias_fix_std > 0.0) || !std::isfinite(gnss_bias_fix_std))
-    return "gnss_bias_fix_std must be finite and > 0";
+    return core::badValue("gnss_bias_fix_std", static_cast<double>(gnss_bias_fix_std), "finite and > 0");
   return "";
 }
 

@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Issue "One options schema": a node given an out-of-range parameter stops with one FATAL line naming the key,
+# the value and the allowed range (exit status 1); a node given an unknown parameter (a typo) warns once, naming
+# the closest known key, and keeps running. Checked for leg_detector, gnss_ingest and tpf_tracker against a real
+# rosmaster. Usage: check_param_errors.sh PACKAGE_DIR (run through the devel space's env.sh).
+set -u
+pkg="$1"
+map="$pkg/config/maps/riseholme.tmap2"
+port=$((21000 + RANDOM % 20000))
+export ROS_MASTER_URI="http://localhost:$port" ROS_HOSTNAME=localhost
+export ROS_HOME="${ROS_HOME:-$(mktemp -d)}"
+rosmaster --core -p "$port" > /dev/null 2>&1 &
+master=$!
+trap 'kill $master 2>/dev/null' EXIT
+for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
+fail=0
+# node args... : run for at most 15 s, print stdout+stderr, return the exit status (124: still running)
+# (its private parameters are deleted first: rosrun's _key:=value stays on the parameter server)
+run() {
+  local node="$1"; shift
+  rosparam delete "/$node" > /dev/null 2>&1
+  timeout 15 rosrun picker_localisation "$node" "$@" 2>&1 | sed 's/\x1b\[[0-9;]*m//g'
+  return "${PIPESTATUS[0]}"
+}
+common_gnss=(_pickers_file:="$pkg/config/pickers.yaml" _datum_file:="$pkg/config/datum.yaml" _map_file:="$map")
+common_tpf=(_pickers_file:="$pkg/config/pickers.yaml" _map_file:="$map" _tpf_params_file:="$pkg/config/tpf.yaml")
+
+expect_fatal() { # node key value pattern args...
+  local node="$1" key="$2" value="$3" pattern="$4"; shift 4
+  local out rc fatal
+  out="$(run "$node" "_$key:=$value" "$@")"; rc=$?
+  fatal="$(printf '%s\n' "$out" | grep -c 'FATAL')"
+  if [ $rc -ne 1 ] || [ "$fatal" -ne 1 ] || ! printf '%s' "$out" | grep 'FATAL' | grep -q -- "$pattern"; then
+    echo "FAIL: $node _$key:=$value: rc=$rc, $fatal FATAL line(s), want 1 matching '$pattern':"; printf '%s\n' "$out" | tail -5
+    fail=1
+  else
+    echo "ok: $node _$key:=$value -> $(printf '%s\n' "$out" | grep FATAL | sed 's/.*]: //')"
+  fi
+}
+expect_warning() { # node typo pattern args...
+  local node="$1" typo="$2" pattern="$3"; shift 3
+  local out rc
+  out="$(run "$node" "_$typo:=10" "$@")"; rc=$?
+  if [ $rc -ne 124 ] || [ "$(printf '%s\n' "$out" | grep -c -- "$pattern")" -ne 1 ] || printf '%s' "$out" | grep -q FATAL; then
+    echo "FAIL: $node _$typo:=10: rc=$rc (want 124: still running after 15 s), want one line matching '$pattern':"
+    printf '%s\n' "$out" | tail -5
+    fail=1
+  else
+    echo "ok: $node _$typo:=10 -> $(printf '%s\n' "$out" | grep -- "$pattern" | sed 's/.*]: //')"
+  fi
+}
+
+expect_fatal leg_detector leg_threshold -1 "leg_threshold = -1: must be in \[0, 1\]" _map_file:="$map"
+expect_warning leg_detector leg_treshold "unknown key 'leg_treshold' (did you mean 'leg_threshold'?)" _map_file:="$map"
+expect_fatal gnss_ingest association_min_probability 0.3 "association_min_probability = 0.3: must be in (0.5, 1\]" \
+  "${common_gnss[@]}"
+expect_warning gnss_ingest association_min_probabilty \
+  "unknown key 'association_min_probabilty' (did you mean 'association_min_probability'?)" "${common_gnss[@]}"
+expect_fatal tpf_tracker num_particles 0 "num_particles = 0: must be > 0" "${common_tpf[@]}"
+expect_warning tpf_tracker num_particle "unknown key 'num_particle' (did you mean 'num_particles'?)" "${common_tpf[@]}"
+exit $fail
