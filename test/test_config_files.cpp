@@ -52,8 +52,10 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   unknown.clear();
   EXPECT_NO_THROW(sensors::LegPipelineOptions::fromYamlFiles({config("vision.yaml"), use("vision_sim.yaml")}, &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
+  unknown.clear();
+  EXPECT_NO_THROW(nbs::PlannerConfig::fromYamlFile(use("nbs.yaml"), &unknown));
+  EXPECT_TRUE(unknown.empty()) << joined(unknown);
   // No unknown-key check in these readers yet (issue "One options schema"): they must load and validate.
-  EXPECT_NO_THROW(nbs::PlannerConfig::fromYamlFile(use("nbs.yaml")));
   EXPECT_NO_THROW(sim::loadSimConfig(use("sim.yaml")));  // throws on an unknown key itself
   EXPECT_NO_THROW(sensors::GeodeticDatum::load(use("datum.yaml")));
   EXPECT_NO_THROW(core::PickerRegistry::load(use("pickers.yaml")));
@@ -75,6 +77,15 @@ TEST(ConfigFiles, TpfParamsWarnAboutATypoAndNameTheKey) {
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].find("'num_particle'"), std::string::npos) << unknown[0];
   EXPECT_NE(unknown[0].find("did you mean 'num_particles'"), std::string::npos) << unknown[0];
+  // The planner: a typo at the top and in a section.
+  unknown.clear();
+  nbs::PlannerConfig::fromYaml(YAML::Load("{horizon_hop: 3, energy: {capacty: 1.0}, planning_period: 5}"),
+                               &unknown);
+  ASSERT_EQ(unknown.size(), 2u) << joined(unknown);
+  EXPECT_NE(unknown[0].find("did you mean 'horizon_hops'"), std::string::npos) << unknown[0];
+  EXPECT_NE(unknown[1].find("nbs config: energy: unknown key 'capacty' (did you mean 'capacity'?)"),
+            std::string::npos)
+      << unknown[1];
   // Every key of the shipped file is a known key (the list is not stale either way).
   const YAML::Node shipped = YAML::LoadFile(config("tpf.yaml"));
   for (const auto& kv : shipped) {

@@ -1,5 +1,7 @@
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
+#include "picker_localisation/core/yaml_keys.h"
+
 #include "picker_localisation/core/yaml_file.h"
 
 #include <algorithm>
@@ -158,9 +160,41 @@ std::string PlannerConfig::validate() const {
   return "";
 }
 
-PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node) {
+const std::vector<std::string>& PlannerConfig::yamlKeys() {
+  static const std::vector<std::string> keys = {
+      "policy",       "weights",        "interactions",          "horizon_hops",
+      "horizon_m",    "horizon_bucket", "planning_latency",      "rfid",
+      "lidar",        "energy",         "claimed_picker_weight", "claim_exclusion_hops",
+      "target_picker"};
+  return keys;
+}
+
+const std::vector<std::string>& PlannerConfig::nodeKeys() {
+  static const std::vector<std::string> keys = {
+      "robot_id",     "map_frame",    "base_frame",  "battery_level", "claim_timeout",
+      "tf_timeout",   "max_pose_age", "use_what_if", "what_if_seed",  "planning_period",
+      "pickers_file", "fleet",        "num_robots",  "battery_topic", "goal_pose_topic",
+      "map_file",     "map_topic",    "map_timeout", "belief_topic",  "registry_topic"};
+  return keys;
+}
+
+PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::string>* unknown) {
   PlannerConfig c;
   if (!node) return c;
+  if (unknown && node.IsMap()) {
+    std::vector<std::string> known = yamlKeys();
+    known.insert(known.end(), nodeKeys().begin(), nodeKeys().end());
+    for (auto& m : core::unknownKeys(node, known, "nbs config")) unknown->push_back(std::move(m));
+    const std::vector<std::pair<const char*, std::vector<std::string>>> sections = {
+        {"weights", criterionNames()},
+        {"rfid", {"read_range", "p_detect", "min_sensing_time", "max_sensing_time"}},
+        {"lidar", {"view_range", "p_detect"}},
+        {"energy", {"capacity", "drive_energy_per_m", "base_power", "sensing_power", "speed", "reserve"}}};
+    for (const auto& [section, keys] : sections)
+      if (node[section])
+        for (auto& m : core::unknownKeys(node[section], keys, std::string("nbs config: ") + section))
+          unknown->push_back(std::move(m));
+  }
   if (node["policy"]) {
     try {
       c.policy = policyFromString(node["policy"].as<std::string>());
@@ -215,9 +249,9 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node) {
   return c;
 }
 
-PlannerConfig PlannerConfig::fromYamlFile(const std::string& path) {
-  return core::parseYamlFile(path, [](const YAML::Node& root) {
-    return fromYaml(root["nbs_planner"] ? root["nbs_planner"] : root);
+PlannerConfig PlannerConfig::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [unknown](const YAML::Node& root) {
+    return fromYaml(root["nbs_planner"] ? root["nbs_planner"] : root, unknown);
   });
 }
 

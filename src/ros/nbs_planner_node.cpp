@@ -38,7 +38,10 @@ nbs::PlannerConfig plannerConfigFromParams(const ros::NodeHandle& pnh) {
     return nbs::PlannerConfig();
   YAML::Node node = toYaml(all);
   // Integer-valued doubles given as ints (e.g. horizon_m: 20) convert fine through YAML scalars.
-  return nbs::PlannerConfig::fromYaml(node);
+  std::vector<std::string> unknown;
+  nbs::PlannerConfig config = nbs::PlannerConfig::fromYaml(node, &unknown);
+  for (const std::string& u : unknown) ROS_WARN("%s: %s", ros::this_node::getName().c_str(), u.c_str());
+  return config;
 }
 
 NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)

@@ -113,9 +113,15 @@ struct PlannerConfig {
   FuzzyMeasure measure() const;  // throws std::invalid_argument on bad weights / interactions
   std::string validate() const;  // "" when valid
 
-  // Keys as config/nbs.yaml (missing keys keep the defaults). Throws std::runtime_error naming the key.
-  static PlannerConfig fromYaml(const YAML::Node& node);
-  static PlannerConfig fromYamlFile(const std::string& path);
+  // Keys as config/nbs.yaml (missing keys keep the defaults). Throws std::runtime_error naming the key. With
+  // `unknown`, one message per key that is neither the planner's (yamlKeys(), and the sub-keys of weights,
+  // rfid, lidar, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest known key.
+  static PlannerConfig fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static PlannerConfig fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();
+  // Parameters of the nbs_planner node (and the runner's planning_period / battery_level / what_if_seed) that
+  // config/nbs.yaml may hold beside the planner's own keys.
+  static const std::vector<std::string>& nodeKeys();
 };
 
 // A goal taken by another robot.
