@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
-#include <iostream>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -352,12 +351,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   double prediction_period = 4.0;
   if (spec.tracker == Tracker::kTpf) {
     const std::string tpf_file = resolveConfigFile(config.tpf_config, "tpf.yaml");
-    std::vector<std::string> unknown;
-    tpf::TpfParams base =
-        tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file, &unknown);
-    static std::atomic<bool> warned{false};  // once per process, not once per run
-    if (!unknown.empty() && !warned.exchange(true))
-      for (const std::string& u : unknown) std::cerr << "experiment: " << tpf_file << ": " << u << "\n";
+    tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
     const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
     prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
     for (std::size_t i = 0; i < n; ++i)
@@ -632,6 +626,29 @@ void writeBiasByAge(const std::string& path, const std::vector<RunResult>& runs,
   log << "\n";
 }
 
+// Keys of the configuration files the runs read that their schemas do not know (typos), logged once here as
+// the nodes warn at start-up; a bad value is left to the runs, which report it per run.
+void logUnknownKeys(const RunConfig& config, std::ostream& log) {
+  auto check = [&log](const std::string& file, auto&& load) {
+    if (file.empty()) return;
+    std::vector<std::string> unknown;
+    try {
+      load(file, &unknown);
+    } catch (const std::exception&) {
+      return;
+    }
+    for (const std::string& u : unknown) log << "  warning: " << file << ": " << u << "\n";
+  };
+  check(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"), sensors::GnssIngestOptions::fromYamlFile);
+  check(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml"), sensors::RfidModelOptions::fromYamlFile);
+#ifdef PL_HAVE_TPF
+  check(resolveConfigFile(config.tpf_config, "tpf.yaml"), tpf::TpfParams::fromYamlFile);
+#endif
+#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
+  check(resolveConfigFile(config.nbs_config, "nbs.yaml"), nbs::PlannerConfig::fromYamlFile);
+#endif
+}
+
 }  // namespace
 
 ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log) {
@@ -649,6 +666,7 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
   log << "experiment: map " << map->name() << " (" << map->numNodes() << " nodes, " << map->numLanes()
       << " lanes), scenario " << toString(config.scenario) << ", " << config.runs << " runs, seed "
       << config.seed << ", " << config.duration << " s simulated, " << config.jobs << " job(s)\n";
+  logUnknownKeys(config.run, log);
   for (const auto& method : methods) {
     RunConfig rc = config.run;
     rc.scenario = config.scenario;

@@ -1,8 +1,7 @@
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
-#include "picker_localisation/core/yaml_keys.h"
-
 #include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
 
 #include <algorithm>
 #include <cctype>

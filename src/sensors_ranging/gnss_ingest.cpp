@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -139,9 +140,7 @@ std::string PickerAssociationOptions::validate() const {
 }
 
 bool PickerAssociationOptions::isIdentitySensor(const std::string& sensor) const {
-  for (const std::string& s : identity_sensors)
-    if (s == sensor) return true;
-  return false;
+  return std::find(identity_sensors.begin(), identity_sensors.end(), sensor) != identity_sensors.end();
 }
 
 const char* toString(GnssRejection r) {

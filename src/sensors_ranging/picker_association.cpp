@@ -83,22 +83,26 @@ double IdentityEvidence::ratio(const std::string& picker_id, double t, const Eig
                                const topology::TopologicalMap& map, const PickerAssociationOptions& o) const {
   const auto picker = items_.find(picker_id);
   if (picker == items_.end()) return 1.0;
-  const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (covariance + covariance.transpose()));
-  if (llt.info() != Eigen::Success) return 1.0;
-  const Eigen::Matrix2d root = llt.matrixL();
   // 3-point Gauss-Hermite rule per axis (nodes 0, +-sqrt(3) sigma; weights 2/3, 1/6, 1/6): exact for a
   // polynomial of degree 5 in each axis.
   static const double kNode[3] = {0.0, std::sqrt(3.0), -std::sqrt(3.0)};
   static const double kWeight[3] = {2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0};
   topology::NodeIndex points[9];
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b)
-      points[3 * a + b] = map.nearestNode(mean + root * Eigen::Vector2d(kNode[a], kNode[b]));
-  const topology::NodeIndex at_detection = map.nearestNode(z);
+  topology::NodeIndex at_detection = topology::kInvalidNode;  // found with the first evidence in the window
   double rho = 1.0;
   for (const auto& entry : picker->second) {
     const Item& item = entry.second;
     if (std::abs(t - item.stamp) > o.identity_window) continue;
+    if (at_detection ==
+        topology::kInvalidNode) {  // this runs per detection and picker: no lookups until needed
+      const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (covariance + covariance.transpose()));
+      if (llt.info() != Eigen::Success) return 1.0;
+      const Eigen::Matrix2d root = llt.matrixL();
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          points[3 * a + b] = map.nearestNode(mean + root * Eigen::Vector2d(kNode[a], kNode[b]));
+      at_detection = map.nearestNode(z);
+    }
     auto value = [&item](topology::NodeIndex n) {
       const auto it = item.likelihood.find(n);
       return it == item.likelihood.end() ? 0.0 : it->second;

@@ -1,8 +1,7 @@
 #include "picker_localisation/tpf/tpf_params.h"
 
-#include "picker_localisation/core/yaml_keys.h"
-
 #include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
 
 #include <algorithm>
 #include <cmath>
@@ -53,28 +52,26 @@ std::string TpfParams::validate() const {
   if (!finite_nonneg(dwell_init_min) || !std::isfinite(dwell_init_max) || dwell_init_max < dwell_init_min)
     return core::badValue("dwell_init_min", dwell_init_min, ">= 0 and <= dwell_init_max");
   if (!std::isfinite(dwell_noise_min) || !std::isfinite(dwell_noise_max) || dwell_noise_max < dwell_noise_min)
-    return core::badValue("dwell_noise_min", static_cast<double>(dwell_noise_min), "<= dwell_noise_max");
-  if (!finite_nonneg(fixed_lambda))
-    return core::badValue("fixed_lambda", static_cast<double>(fixed_lambda), ">= 0");
+    return core::badValue("dwell_noise_min", dwell_noise_min, "<= dwell_noise_max");
+  if (!finite_nonneg(fixed_lambda)) return core::badValue("fixed_lambda", fixed_lambda, ">= 0");
   if (!(velocity_window >= 1.0) || !std::isfinite(velocity_window))
-    return core::badValue("velocity_window", static_cast<double>(velocity_window), ">= 1");
+    return core::badValue("velocity_window", velocity_window, ">= 1");
   if (!(reinit_fraction > 0.0 && reinit_fraction <= 1.0))
-    return core::badValue("reinit_fraction", static_cast<double>(reinit_fraction), "in (0, 1]");
+    return core::badValue("reinit_fraction", reinit_fraction, "in (0, 1]");
   if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0))
-    return core::badValue("lane_change_leak", static_cast<double>(lane_change_leak), "in [0, 1]");
+    return core::badValue("lane_change_leak", lane_change_leak, "in [0, 1]");
   if (lane_change_max_hops < 1)
     return core::badValue("lane_change_max_hops", static_cast<double>(lane_change_max_hops), ">= 1");
   if (!(lane_change_keep_side >= 0.0 && lane_change_keep_side <= 1.0))
-    return core::badValue("lane_change_keep_side", static_cast<double>(lane_change_keep_side), "in [0, 1]");
+    return core::badValue("lane_change_keep_side", lane_change_keep_side, "in [0, 1]");
   if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate))
-    return core::badValue("reverse_rate", static_cast<double>(reverse_rate), "finite and >= 0");
+    return core::badValue("reverse_rate", reverse_rate, "finite and >= 0");
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
-    return core::badValue("turn_projection_fraction", static_cast<double>(turn_projection_fraction),
-                          "in [0, 1]");
+    return core::badValue("turn_projection_fraction", turn_projection_fraction, "in [0, 1]");
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell))
-    return core::badValue("min_jump_dwell", static_cast<double>(min_jump_dwell), "> 0");
+    return core::badValue("min_jump_dwell", min_jump_dwell, "> 0");
   if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma))
-    return core::badValue("min_velocity_sigma", static_cast<double>(min_velocity_sigma), "> 0");
+    return core::badValue("min_velocity_sigma", min_velocity_sigma, "> 0");
   for (const auto& [name, g] : sensor_gammas)
     if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity) || (gamma_as_confidence && g.node > 1.0))
       return "sensor_gammas." + name + " must be finite and >= 0 (node <= 1 with gamma_as_confidence)";
@@ -82,21 +79,18 @@ std::string TpfParams::validate() const {
       (gamma_as_confidence && default_gamma.node > 1.0))
     return "default_gamma must be finite and >= 0";
   if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0))
-    return core::badValue("jsd_threshold", static_cast<double>(jsd_threshold), "in [0, 1]");
+    return core::badValue("jsd_threshold", jsd_threshold, "in [0, 1]");
   if (!(reinit_max_mean_likelihood > 0.0 && reinit_max_mean_likelihood <= 1.0))
-    return core::badValue("reinit_max_mean_likelihood", static_cast<double>(reinit_max_mean_likelihood),
-                          "in (0, 1]");
+    return core::badValue("reinit_max_mean_likelihood", reinit_max_mean_likelihood, "in (0, 1]");
   if (!finite_nonneg(entropy_threshold))
-    return core::badValue("entropy_threshold", static_cast<double>(entropy_threshold), ">= 0");
+    return core::badValue("entropy_threshold", entropy_threshold, ">= 0");
   if (!(unconnected_jump_probability >= 0.0 && unconnected_jump_probability <= 1.0))
-    return core::badValue("unconnected_jump_probability", static_cast<double>(unconnected_jump_probability),
-                          "in [0, 1]");
+    return core::badValue("unconnected_jump_probability", unconnected_jump_probability, "in [0, 1]");
   if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate))
-    return core::badValue("prediction_rate", static_cast<double>(prediction_rate), ">= 0");
-  if (!finite_nonneg(reorder_window))
-    return core::badValue("reorder_window", static_cast<double>(reorder_window), ">= 0");
+    return core::badValue("prediction_rate", prediction_rate, ">= 0");
+  if (!finite_nonneg(reorder_window)) return core::badValue("reorder_window", reorder_window, ">= 0");
   if (!(gnss_bias_fix_std > 0.0) || !std::isfinite(gnss_bias_fix_std))
-    return core::badValue("gnss_bias_fix_std", static_cast<double>(gnss_bias_fix_std), "finite and > 0");
+    return core::badValue("gnss_bias_fix_std", gnss_bias_fix_std, "finite and > 0");
   return "";
 }
 
