@@ -1,7 +1,6 @@
 # sensors_ranging: GNSS ingestion, RFID ranging, UWB ranging with the Range Histogram Filter.
 # ROS-free core library (namespace picker_localisation::sensors).
 add_library(picker_localisation_sensors_ranging
-  src/sensors_ranging/geodetic_datum.cpp
   src/sensors_ranging/gnss_bias.cpp
   src/sensors_ranging/gnss_ingest.cpp
   src/sensors_ranging/picker_association.cpp

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "picker_localisation/ros/ranging_nodes.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 
 namespace ranging_test {
 
@@ -60,7 +60,7 @@ inline std::size_t countFor(const std::vector<picker_localisation::Observation>&
 }
 
 // A good NavSatFix at map position p (diagonal covariance 1 m^2 east / north).
-inline sensor_msgs::NavSatFix fixAt(const picker_localisation::sensors::GeodeticDatum& datum, const Eigen::Vector2d& p,
+inline sensor_msgs::NavSatFix fixAt(const picker_localisation::core::GeodeticDatum& datum, const Eigen::Vector2d& p,
                                     const ros::Time& stamp) {
   return picker_localisation::ros_adapter::navSatFixAt(datum, p, stamp, 1.0);
 }

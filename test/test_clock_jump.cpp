@@ -15,7 +15,7 @@
 #include <functional>
 #include <vector>
 
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "ranging_rostest_util.h"
 
 using ranging_test::waitFor;
@@ -36,7 +36,7 @@ TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
   ASSERT_TRUE(waitFor([&] { return fix.getNumSubscribers() > 0 && sub.getNumPublishers() > 0 &&
                                     clock.getNumSubscribers() >= 3 && truth.getNumSubscribers() > 0 &&
                                     error_sub.getNumPublishers() > 0; }, 30.0));
-  const auto datum = picker_localisation::sensors::GeodeticDatum::load(std::string(PL_PACKAGE_DIR) +
+  const auto datum = picker_localisation::core::GeodeticDatum::load(std::string(PL_PACKAGE_DIR) +
                                                                          "/config/datum.yaml");
   auto run = [&](double t0, double t1) {
     for (double t = t0; t <= t1 + 1e-9; t += 0.1) {

@@ -11,7 +11,7 @@
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_vision/leg_pipeline.h"
@@ -57,7 +57,7 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   // No unknown-key check in these readers yet (issue "One options schema"): they must load and validate.
   EXPECT_NO_THROW(sim::loadSimConfig(use("sim.yaml")));  // throws on an unknown key itself
-  EXPECT_NO_THROW(sensors::GeodeticDatum::load(use("datum.yaml")));
+  EXPECT_NO_THROW(core::GeodeticDatum::load(use("datum.yaml")));
   EXPECT_NO_THROW(core::PickerRegistry::load(use("pickers.yaml")));
   EXPECT_NO_THROW(topology::loadMap(config("maps/riseholme.tmap2")));
   // Read by uwb_ranging key by key (no options schema yet): listed so that a new file is not missed silently.

@@ -95,7 +95,7 @@ constexpr int kIterations = 3000;
 
 TEST(Fuzz, GnssIngestTakesAnyFix) {
   const auto map = riseholme();
-  const sensors::GeodeticDatum datum = sensors::GeodeticDatum::load(kPackage + "/config/datum.yaml");
+  const core::GeodeticDatum datum = core::GeodeticDatum::load(kPackage + "/config/datum.yaml");
   sensors::GnssIngest gnss("picker_1", map, datum, sensors::GnssIngestOptions::fromYamlFile(
                                                        kPackage + "/config/gnss_ingest.yaml"));
   const Eigen::Vector2d home = datum.toLatLon(Eigen::Vector2d(20.0, -20.0));
@@ -103,7 +103,7 @@ TEST(Fuzz, GnssIngestTakesAnyFix) {
   double t = 100.0;
   std::size_t accepted = 0;
   for (int i = 0; i < kIterations; ++i) {
-    sensors::GnssFix f;
+    core::GnssFix f;
     t += 1.0;
     f.stamp = w.chance(0.9) ? t : w.value(t, 50.0);
     if (f.stamp > t + 10.0) continue;  // the node's StampGuard drops these before the core sees them
@@ -112,7 +112,7 @@ TEST(Fuzz, GnssIngestTakesAnyFix) {
     f.altitude = w.value(50.0, 10.0);
     f.status = static_cast<int>(w.index(5)) - 2;
     f.covariance_type = static_cast<int>(w.index(6)) - 1;
-    for (double& c : f.covariance) c = w.chance(0.6) ? 4.0 : w.value(1.0, 10.0);
+    for (double& c : f.position_covariance) c = w.chance(0.6) ? 4.0 : w.value(1.0, 10.0);
     sensors::GnssResult r;
     ASSERT_NO_THROW(r = gnss.process(f)) << "fix " << i;
     if (r.accepted()) {
@@ -144,7 +144,7 @@ TEST(Fuzz, RfidModelTakesAnyRead) {
     t += 0.2;
     r.stamp = w.chance(0.9) ? t : w.value(t, 5.0);
     r.robot_id = "robot_1";
-    r.antenna_id = w.name({"robot_1/rfid_left", "robot_1/rfid_right"});
+    r.frame_id = w.name({"robot_1/rfid_left", "robot_1/rfid_right"});
     r.tag_id = w.name({"rfid_0001", "rfid_0002", "rfid_0003"});
     r.antenna_pose = Eigen::Vector3d(w.value(20.0, 10.0), w.value(-20.0, 10.0), w.value(0.0, 3.0));
     r.rssi = w.value(-60.0, 10.0);
@@ -173,7 +173,7 @@ TEST(Fuzz, UwbRangingTakesAnyRange) {
     in.stamp = w.chance(0.95) ? t : w.value(t, 2.0);
     in.robot_id = "robot_1";
     in.tag_id = w.name({"uwb_0001", "uwb_0002"});
-    in.anchor_id = w.name({"a0", "a1", "a2"});
+    in.frame_id = w.name({"a0", "a1", "a2"});
     in.anchor_in_robot = Eigen::Translation2d(w.uniform(-0.5, 0.5), w.uniform(-0.5, 0.5)) * Eigen::Rotation2Dd(0.0);
     in.range = w.value(3.0, 2.0);
     in.variance = w.value(0.01, 0.05);
@@ -211,7 +211,7 @@ TEST(Fuzz, LegPipelineTakesAnyScan) {
     msg.ranges.resize(w.size(700));
     for (float& r : msg.ranges) r = static_cast<float>(w.chance(0.8) ? w.uniform(0.5, 6.0) : w.value(3.0, 3.0));
     msg.intensities.resize(w.size(10));
-    sensors::LaserScanData scan;
+    core::LaserScan scan;
     ASSERT_NO_THROW(scan = ros_adapter::toScanData(msg)) << "scan " << i;
     const Eigen::Isometry3d tf = Eigen::Translation3d(20.0, -20.0, 0.3) * Eigen::AngleAxisd(w.uniform(-3, 3), Eigen::Vector3d::UnitZ());
     std::vector<sensors::TrackedPerson> people;

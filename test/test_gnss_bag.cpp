@@ -17,6 +17,8 @@
 
 using namespace picker_localisation;
 using namespace picker_localisation::sensors;
+using picker_localisation::core::DatumConfig;
+using picker_localisation::core::GeodeticDatum;
 
 namespace {
 const std::string kBag = std::string(PL_SHARED_DATA) + "/robot_localization/test/test1.bag";

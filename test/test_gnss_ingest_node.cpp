@@ -13,11 +13,11 @@
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/ros/observation_conversions.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/topology/map_io.h"
 #include "ranging_rostest_util.h"
 
-using picker_localisation::sensors::GeodeticDatum;
+using picker_localisation::core::GeodeticDatum;
 
 using ranging_test::fixAt;
 

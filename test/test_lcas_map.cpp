@@ -14,8 +14,8 @@
 #include <mutex>
 #include <sstream>
 
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/ros/ranging_nodes.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
 #include "picker_localisation/topology/map_io.h"
 
 using namespace picker_localisation;
@@ -104,10 +104,10 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
       });
   ros::Publisher fix_pub = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_1/fix", 10);
 
-  sensors::DatumConfig c;
+  core::DatumConfig c;
   c.latitude = kDatumLatitude;
   c.longitude = kDatumLongitude;
-  const sensors::GeodeticDatum datum(c);
+  const core::GeodeticDatum datum(c);
   const std::string expected = lcas_map.node(target).name;
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(60.0);
   bool reached = false;

@@ -8,7 +8,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_bias.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/picker_association.h"
@@ -19,6 +19,8 @@
 
 using namespace picker_localisation;
 using namespace picker_localisation::sensors;
+using picker_localisation::core::DatumConfig;
+using picker_localisation::core::GeodeticDatum;
 using topology::NodeIndex;
 
 namespace {
@@ -122,15 +124,15 @@ namespace {
 struct GnssFixture {
   std::shared_ptr<const topology::TopologicalMap> map = latticeMap(20.0, 1.0);
   GeodeticDatum datum{riseholmeDatum()};
-  GnssFix fixAt(double t, const Eigen::Vector2d& p, double var = 1.0, int cov_type = 2) const {
-    GnssFix f;
+  core::GnssFix fixAt(double t, const Eigen::Vector2d& p, double var = 1.0, int cov_type = 2) const {
+    core::GnssFix f;
     f.stamp = t;
     const Eigen::Vector2d ll = datum.toLatLon(p);
     f.latitude = ll.x();
     f.longitude = ll.y();
     f.altitude = 0.0;
     f.status = 0;
-    f.covariance = {var, 0, 0, 0, var, 0, 0, 0, 4 * var};
+    f.position_covariance = {var, 0, 0, 0, var, 0, 0, 0, 4 * var};
     f.covariance_type = cov_type;
     return f;
   }
@@ -166,7 +168,7 @@ TEST(GnssIngest, RejectsBadFixesAndKeepsGoing) {
   GnssFixture fx;
   GnssIngest gnss("picker_1", fx.map, fx.datum);
   ASSERT_TRUE(gnss.process(fx.fixAt(10.0, {0.0, 0.0})).accepted());
-  GnssFix f = fx.fixAt(11.0, {0.5, 0.0});
+  core::GnssFix f = fx.fixAt(11.0, {0.5, 0.0});
   f.status = -1;
   EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNoFix);
   f = fx.fixAt(11.0, {0.5, 0.0});
@@ -176,14 +178,14 @@ TEST(GnssIngest, RejectsBadFixesAndKeepsGoing) {
   f.longitude = std::numeric_limits<double>::infinity();
   EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNotFinite);
   f = fx.fixAt(11.0, {0.5, 0.0});
-  f.covariance[4] = -1.0;
+  f.position_covariance[4] = -1.0;
   EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNegativeCovariance);
   f = fx.fixAt(11.0, {0.5, 0.0});
   f.covariance_type = 3;
-  f.covariance[1] = f.covariance[3] = 5.0;  // |cov| > sqrt(var_x var_y): not PSD
+  f.position_covariance[1] = f.position_covariance[3] = 5.0;  // |cov| > sqrt(var_x var_y): not PSD
   EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNegativeCovariance);
   f = fx.fixAt(11.0, {0.5, 0.0});
-  f.covariance[0] = kNaN;
+  f.position_covariance[0] = kNaN;
   EXPECT_EQ(gnss.process(f).rejection, GnssRejection::kNotFinite);
   EXPECT_EQ(gnss.process(fx.fixAt(10.0, {0.5, 0.0})).rejection, GnssRejection::kOutOfOrder);  // repeated
   EXPECT_EQ(gnss.process(fx.fixAt(9.0, {0.5, 0.0})).rejection, GnssRejection::kOutOfOrder);   // backwards
@@ -297,7 +299,7 @@ TEST(RfidObservationModel, LogisticReadProbabilityLikelihood) {
   RfidRead read;
   read.stamp = 1.0;
   read.robot_id = "robot_1";
-  read.antenna_id = "robot_1/rfid_antenna";
+  read.frame_id = "robot_1/rfid_antenna";
   read.tag_id = "rfid_2";
   RfidResult r = rfid.process(read);
   ASSERT_TRUE(r.accepted());
@@ -340,7 +342,7 @@ TEST(RfidObservationModel, ReadRegionLikelihoodAndBadInput) {
   RfidRead read;
   read.stamp = 1.0;
   read.robot_id = "robot_1";
-  read.antenna_id = "robot_1/rfid_antenna";
+  read.frame_id = "robot_1/rfid_antenna";
   read.tag_id = "rfid_2";
   read.antenna_pose = Eigen::Vector3d(0.0, 0.0, 0.0);
   RfidResult r = rfid.process(read);
@@ -389,7 +391,7 @@ TEST(RfidObservationModel, LogisticNegativeInformation) {
   o.negative_period = 5.0;
   RfidObservationModel rfid(twoPickers(), map, o);
   RfidRead read;
-  read.antenna_id = "a";
+  read.frame_id = "a";
   read.tag_id = "rfid_1";
   std::size_t negatives = 0;
   for (int i = 0; i <= 5; ++i) {
@@ -418,7 +420,7 @@ TEST(RfidObservationModel, NegativeInformationForPickersNotRead) {
   o.p_detect = 0.7;
   RfidObservationModel rfid(twoPickers(), map, o);
   RfidRead read;
-  read.antenna_id = "a";
+  read.frame_id = "a";
   read.tag_id = "rfid_1";
   std::vector<double> negative_stamps;
   for (int i = 0; i <= 12; ++i) {
@@ -625,7 +627,7 @@ UwbRangeInput uwbInput(double t, const std::string& tag, int anchor, double rang
   in.stamp = t;
   in.robot_id = "robot_1";
   in.tag_id = tag;
-  in.anchor_id = "robot_1/uwb_anchor_" + std::to_string(anchor);
+  in.frame_id = "robot_1/uwb_anchor_" + std::to_string(anchor);
   in.anchor_in_robot = Eigen::Isometry2d::Identity();
   in.anchor_in_robot.translation() = kAnchors[static_cast<std::size_t>(anchor)];
   in.range = range;
@@ -848,7 +850,7 @@ TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
   RfidRead read;
   read.stamp = 1.0;
   read.robot_id = "robot_1";
-  read.antenna_id = "robot_1/rfid_antenna";
+  read.frame_id = "robot_1/rfid_antenna";
   read.tag_id = "rfid_2";
   const RfidResult first = rfid.process(read);
   ASSERT_TRUE(first.accepted());
@@ -1237,7 +1239,7 @@ TEST(PickerAssociation, AnRfidReadKeepsADetectionFromTheWrongPicker) {
     RfidRead read;
     read.stamp = t;
     read.robot_id = "robot_1";
-    read.antenna_id = "robot_1/rfid";
+    read.frame_id = "robot_1/rfid";
     read.tag_id = "rfid_1";
     read.antenna_pose = Eigen::Vector3d(1.0, 0.0, 0.0);
     const RfidResult r = rfid.process(read);

@@ -395,15 +395,15 @@ TEST(GnssModel, BlackoutsLastThirtyToSixtySeconds) {
 }
 
 TEST(GnssModel, FixesGoThroughTheDatum) {
-  MapDatum datum;
-  datum.heading_deg = 30.0;
-  MapProjection proj(datum);
+  core::DatumConfig config = riseholmeDatum();
+  config.heading = 30.0 * M_PI / 180.0;
+  const core::GeodeticDatum datum(config);
   GnssNoiseParams params;
   GnssErrorModel m(params, 11);
   int fixes = 0, no_fix = 0;
   for (int k = 1; k <= 3000; ++k) {
     const Eigen::Vector2d truth(10.0 + 0.01 * k, -5.0);
-    const auto fix = makeGnssFix(m, proj, params, k, truth);
+    const auto fix = makeGnssFix(m, datum, params, k, truth);
     ASSERT_TRUE(fix);
     if (fix->status == -1) {
       EXPECT_TRUE(std::isnan(fix->latitude));
@@ -411,38 +411,39 @@ TEST(GnssModel, FixesGoThroughTheDatum) {
       continue;
     }
     ++fixes;
-    const Eigen::Vector2d back = proj.toMap(fix->latitude, fix->longitude, fix->altitude);
+    const Eigen::Vector2d back = datum.toMap(fix->latitude, fix->longitude, fix->altitude);
     EXPECT_NEAR((back - (truth + fix->error)).norm(), 0.0, 1e-6);
+    EXPECT_NEAR(fix->altitude, config.altitude + params.antenna_height, 1e-3);
     EXPECT_DOUBLE_EQ(fix->position_covariance[0], params.reported_std * params.reported_std);
   }
   EXPECT_GT(fixes, 0);
-  // Heading 90 deg: map x points North.
-  datum.heading_deg = 90.0;
-  MapProjection north(datum);
+  // Heading 90 deg: map x points North (a degree of latitude is ~111.2 km here).
+  config.heading = M_PI / 2.0;
+  const core::GeodeticDatum north(config);
   double lat, lon, alt;
   north.toGeodetic({100.0, 0.0}, 0.0, lat, lon, alt);
-  EXPECT_NEAR(lon, datum.longitude, 1e-9);
-  EXPECT_NEAR((lat - datum.latitude) * 111200.0, 100.0, 0.5);
+  EXPECT_NEAR(lon, config.longitude, 1e-9);
+  EXPECT_NEAR((lat - config.latitude) * 111200.0, 100.0, 0.5);
 }
 
-TEST(GnssModel, DatumFileKeys) {
-  const std::string path = ::testing::TempDir() + "/datum_test.yaml";
-  {
-    std::ofstream f(path);
-    f << "datum:\n  type: local_cartesian\n  latitude: 53.1\n  longitude: -0.6\n  altitude: 12.0\n  "
-         "heading_deg: 15.0\n";
-  }
-  const MapDatum d = loadMapDatum(path);
-  EXPECT_DOUBLE_EQ(d.latitude, 53.1);
-  EXPECT_DOUBLE_EQ(d.heading_deg, 15.0);
-  // The shipped datum file (sensors_ranging) is readable.
-  const MapDatum shipped = loadMapDatum(std::string(PL_PACKAGE_DIR) + "/config/datum.yaml");
-  EXPECT_NEAR(shipped.latitude, 53.268, 0.01);
-  {
-    std::ofstream f(path);
-    f << "longitude: 1.0\n";
-  }
-  EXPECT_THROW(loadMapDatum(path), std::runtime_error);
+// The `datum:` section of config/sim.yaml has config/datum.yaml's keys (core::DatumConfig), unknown keys
+// refused.
+TEST(GnssModel, SimConfigDatumSectionKeys) {
+  SimConfig c;
+  EXPECT_NEAR(c.datum.latitude, 53.268, 1e-9);  // default: Riseholme, as config/datum.yaml
+  applySimConfigYaml(
+      YAML::Load("datum: {latitude: 53.1, longitude: -0.6, altitude: 12.0, heading_deg: 15.0}"), c);
+  EXPECT_DOUBLE_EQ(c.datum.latitude, 53.1);
+  EXPECT_DOUBLE_EQ(c.datum.altitude, 12.0);
+  EXPECT_NEAR(c.datum.heading, 15.0 * M_PI / 180.0, 1e-12);
+  applySimConfigYaml(
+      YAML::Load("datum: {type: utm, utm_zone: 30, utm_easting: 664000, utm_northing: 5905000}"), c);
+  EXPECT_EQ(c.datum.kind, core::DatumConfig::Kind::kUtm);
+  EXPECT_THROW(applySimConfigYaml(YAML::Load("datum: {latitude: 53.1, longitude: -0.6, headng_deg: 1}"), c),
+               std::runtime_error);
+  EXPECT_THROW(applySimConfigYaml(YAML::Load("datum: {longitude: 1.0}"), c), std::runtime_error);
+  EXPECT_THROW(applySimConfigYaml(YAML::Load("datum: {latitude: 95.0, longitude: 1.0}"), c),
+               std::runtime_error);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -458,7 +459,7 @@ TEST(LaserModel, RayHitsALegCircleAtTheAnalyticRange) {
   params.angle_increment = M_PI / 180.0 / 4.0;
   std::mt19937_64 rng(1);
   const Pose2D sensor{0.0, 0.0, 0.0};
-  const LaserScan scan = castLaser(scene, sensor, params, 1.0, rng);
+  const LaserScanWithTruth scan = castLaser(scene, sensor, params, 1.0, rng);
   auto beam = [&](double angle) {
     return static_cast<std::size_t>(std::lround((angle - scan.angle_min) / scan.angle_increment));
   };
@@ -474,7 +475,7 @@ TEST(LaserModel, RayHitsALegCircleAtTheAnalyticRange) {
   EXPECT_GT(scan.ranges[beam(-M_PI / 4)], 0.0);
   // A rotated, translated sensor sees the same leg at the same range.
   const Pose2D moved{5.0, -2.0, M_PI / 2};
-  const LaserScan s2 = castLaser(scene, moved, params, 1.0, rng);
+  const LaserScanWithTruth s2 = castLaser(scene, moved, params, 1.0, rng);
   EXPECT_NEAR(s2.ranges[beam(0.0)], 2.0 - 0.06, 1e-5);
 }
 
@@ -497,7 +498,7 @@ TEST(LaserModel, BeamWindowsMatchTestingEveryBeam) {
       params.angle_max = 2.356194;
     }
     const Pose2D pose{u(rng) * 0.2, u(rng) * 0.2, ang(rng)};
-    const LaserScan scan = castLaser(scene, pose, params, 0.0, rng);
+    const LaserScanWithTruth scan = castLaser(scene, pose, params, 0.0, rng);
     for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
       const double a = pose.yaw + scan.angle_min + i * scan.angle_increment;
       const Eigen::Vector2d d(std::cos(a), std::sin(a));
@@ -601,7 +602,7 @@ TEST(RfidModel, ReadProbabilityFallsWithDistance) {
     std::vector<double> rssi;
     const int n = 20000;
     for (int k = 0; k < n; ++k) {
-      RfidRead r;
+      RfidReadingWithTruth r;
       if (simulateRfidRead(p, d, rng, r)) {
         ++reads;
         rssi.push_back(r.rssi);
@@ -619,7 +620,7 @@ TEST(RfidModel, ReadProbabilityFallsWithDistance) {
       prev_rssi = mean(rssi);
     }
   }
-  RfidRead r;
+  RfidReadingWithTruth r;
   for (int k = 0; k < 1000; ++k) EXPECT_FALSE(simulateRfidRead(p, p.max_range + 0.1, rng, r));
 }
 
@@ -630,7 +631,7 @@ TEST(UwbModel, RangeNoiseAndNlosOutliers) {
   int dropped = 0;
   const int n = 40000;
   for (int k = 0; k < n; ++k) {
-    UwbReading u;
+    UwbRangeWithTruth u;
     if (!simulateUwbRange(p, 6.0, rng, u)) {
       ++dropped;
       continue;
@@ -644,7 +645,7 @@ TEST(UwbModel, RangeNoiseAndNlosOutliers) {
   EXPECT_NEAR(static_cast<double>(nlos_err.size()) / (n - dropped), p.p_nlos, 0.005);
   EXPECT_NEAR(mean(nlos_err), p.nlos_mean, 0.08);
   for (double e : nlos_err) EXPECT_GT(e, -0.5);
-  UwbReading u;
+  UwbRangeWithTruth u;
   for (int k = 0; k < 200; ++k) EXPECT_FALSE(simulateUwbRange(p, p.max_range + 1.0, rng, u));
 }
 
@@ -769,7 +770,7 @@ TEST(FarmSimulator, PickersAndGnssIndependentOfRobotsAndSensorSwitches) {
   c.num_robots = 3;
   c.robot_motion.patrol = PatrolPolicy::kRandom;
   FarmSimulator b(map, c);
-  std::vector<GnssFix> fa, fb;
+  std::vector<GnssFixWithTruth> fa, fb;
   for (int k = 0; k < 120; ++k) {
     auto oa = a.step(0.5), ob = b.step(0.5);
     fa.insert(fa.end(), oa.gnss.begin(), oa.gnss.end());

@@ -14,6 +14,7 @@
 #include "picker_localisation/sensors_vision/munkres.h"
 #include "picker_localisation/sensors_vision/person_box_detector.h"
 
+using namespace picker_localisation;
 using namespace picker_localisation::sensors;
 
 namespace {
@@ -90,8 +91,8 @@ TEST(Bearing, HandComputedValues) {
 namespace {
 
 // A scan with beams 1 degree apart; `objects` are (first beam, last beam, range) blocks, the rest no return.
-LaserScanData blockScan(const std::vector<std::tuple<int, int, float>>& objects, int beams = 180) {
-  LaserScanData s;
+core::LaserScan blockScan(const std::vector<std::tuple<int, int, float>>& objects, int beams = 180) {
+  core::LaserScan s;
   s.angle_min = -M_PI / 2;
   s.angle_increment = M_PI / 180.0;
   s.range_min = 0.05;
@@ -122,7 +123,7 @@ TEST(Segmentation, JumpDistanceSplitsAndRichnessFilters) {
   empty.ranges[5] = std::nanf("");
   empty.ranges[6] = 0.01f;
   EXPECT_TRUE(segmentScan(empty).empty());
-  LaserScanData zero;
+  core::LaserScan zero;
   EXPECT_TRUE(segmentScan(zero).empty());
 }
 

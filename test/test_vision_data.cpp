@@ -48,7 +48,7 @@ TEST(LegDetectorRealData, HeldOutPositivesRecallAndPrecision) {
 TEST(LegDetectorRealData, HeldOutNegativesFalseLegsPerScan) {
   const auto all = ros_adapter::readBagScans(kLegData + "/negative_2.bag");
   ASSERT_GT(all.size(), 1000u);
-  std::vector<LaserScanData> held;
+  std::vector<core::LaserScan> held;
   for (std::size_t i = negativeTrainCount(all.size()); i < all.size(); ++i) held.push_back(all[i].scan);
   LegDetector detector(loadModel());
   const auto e = evaluateNegatives(detector, held);

@@ -223,34 +223,12 @@ struct Event {
   std::size_t index;
 };
 
-sensors::GnssFix toIngestFix(const sim::GnssFix& f) {
-  sensors::GnssFix g;
-  g.stamp = f.stamp;
-  g.latitude = f.latitude;
-  g.longitude = f.longitude;
-  g.altitude = f.altitude;
-  g.status = f.status;
-  g.covariance = f.position_covariance;
-  g.covariance_type = f.covariance_type;
-  return g;
-}
-
 // The front-ends' options: the same files and the same schema as the gnss_ingest / rfid_ranging nodes.
 sensors::GnssIngestOptions gnssOptions(const std::string& file) {
   return file.empty() ? sensors::GnssIngestOptions() : sensors::GnssIngestOptions::fromYamlFile(file);
 }
 sensors::RfidModelOptions rfidOptions(const std::string& file) {
   return file.empty() ? sensors::RfidModelOptions() : sensors::RfidModelOptions::fromYamlFile(file);
-}
-
-sensors::GeodeticDatum datumOf(const sim::MapDatum& d) {
-  sensors::DatumConfig c;
-  c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
-  c.latitude = d.latitude;
-  c.longitude = d.longitude;
-  c.altitude = d.altitude;
-  c.heading = d.heading_deg * M_PI / 180.0;
-  return sensors::GeodeticDatum(c);
 }
 
 // The per-picker tracker of a run: a TPF or the picker's view of the shared UKF.
@@ -282,7 +260,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   const std::string datum_file = resolveConfigFile(config.datum_file, "datum.yaml");
   const std::string pickers_file = resolveConfigFile(config.pickers_file, "pickers.yaml");
   sim::SimConfig sc = sim_file.empty() ? sim::SimConfig() : sim::loadSimConfig(sim_file);
-  if (!datum_file.empty()) sc.datum = sim::loadMapDatum(datum_file);
+  if (!datum_file.empty()) sc.datum = core::GeodeticDatum::load(datum_file).config();
   sc.seed = config.seed;
   const std::size_t n = numPickers(config.scenario);
   sc.pickers.clear();
@@ -313,9 +291,8 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   sc.enable.camera = false;
   sim::FarmSimulator simulator(*map, sc);
 
-  // --- front-ends (GnssIngest uses the datum file as the gnss_ingest node does) ---------------------------
-  const sensors::GeodeticDatum datum =
-      datum_file.empty() ? datumOf(simulator.projection().datum()) : sensors::GeodeticDatum::load(datum_file);
+  // --- front-ends (GnssIngest: the simulator's datum, from the datum file as gnss_ingest reads it) ------------
+  const core::GeodeticDatum& datum = simulator.datum();
   const sensors::GnssIngestOptions gnss_options =
       gnssOptions(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"));
   std::vector<PickerTrack> tracks(n);
@@ -424,10 +401,10 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     });
     for (const Event& e : events) {
       if (e.kind == 0) {
-        const sim::GnssFix& f = out.gnss[e.index];
+        const sim::GnssFixWithTruth& f = out.gnss[e.index];
         PickerTrack& t = tracks.at(f.picker_index);
         if (f.error.allFinite()) t.true_gnss_error = f.error;
-        const sensors::GnssResult r = t.gnss->process(toIngestFix(f));
+        const sensors::GnssResult r = t.gnss->process(f);
         if (!r.accepted()) continue;
         if (t.gnss->counters().accepted == 1 || r.blackout_ended > 0.0) {
           t.restart = f.stamp;
@@ -448,16 +425,12 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
           toTracker(*r.observation);
         }
       } else if (e.kind == 1) {
-        const sim::RfidRead& rr = out.rfid[e.index];
+        const sim::RfidReadingWithTruth& rr = out.rfid[e.index];
         sensors::RfidRead read;
-        read.stamp = rr.stamp;
-        read.robot_id = rr.robot_id;
-        read.antenna_id = rr.robot_id + "/" + rr.frame;
-        read.tag_id = rr.tag_id;
-        read.rssi = rr.rssi;
-        sim::Pose2D mount;
+        static_cast<core::RfidReading&>(read) = rr;
+        sim::Pose2D mount;  // the antenna pose the node gets from tf: the simulator's (ground truth)
         for (const auto& m : simulator.config().sensor_layout.rfid_antennas)
-          if (m.frame == rr.frame) mount = m.pose;
+          if (m.frame == rr.mount) mount = m.pose;
         const sim::Pose2D antenna = simulator.robotPose(rr.robot_index).compose(mount);
         read.antenna_pose = Eigen::Vector3d(antenna.x, antenna.y, antenna.yaw);
         const sensors::RfidResult r = rfid_model.process(read);
@@ -472,20 +445,13 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         }
       } else {
 #ifdef PL_HAVE_VISION
-        const sim::LaserScan& s = out.scans[e.index];
-        sensors::LaserScanData scan;
-        scan.stamp = s.stamp;
-        scan.angle_min = s.angle_min;
-        scan.angle_increment = s.angle_increment;
-        scan.range_min = s.range_min;
-        scan.range_max = s.range_max;
-        scan.ranges = s.ranges;
+        const sim::LaserScanWithTruth& s = out.scans[e.index];
         // The sensor pose the node gets from tf, here the simulator's (ground truth) laser pose.
         const Eigen::Isometry3d fixed_from_sensor =
             Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
             Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
         const std::vector<sensors::TrackedPerson> tracked =
-            legs->processScan(s.robot_id + "/" + s.frame, s.stamp, scan, fixed_from_sensor);
+            legs->processScan(s.frame_id, s.stamp, s, fixed_from_sensor);
         result.lidar_detections += tracked.size();
         // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's
         // bias-corrected fix and tracker belief.

@@ -86,7 +86,7 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   pnh_.param<std::string>("datum_source", datum_source, "auto");
   try {
     if (!sim_config.empty()) config = sim::loadSimConfig(sim_config);
-    if (!datum_file.empty()) config.datum = sim::loadMapDatum(datum_file);
+    if (!datum_file.empty()) config.datum = core::GeodeticDatum::load(datum_file).config();
     if (!urdf_template.empty()) config.sensor_layout = sensorLayoutFromUrdfTemplate(urdf_template);
     if (!pickers_file.empty()) {
       registry_ = core::PickerRegistry::load(pickers_file);
@@ -132,10 +132,7 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   if (!map_) return;
   try {
     if (useMapDatum(datum_source, *map_)) {  // the rule gnss_ingest follows, so both use one datum
-      config.datum.latitude = map_->datum()->latitude;
-      config.datum.longitude = map_->datum()->longitude;
-      config.datum.altitude = map_->datum()->altitude;
-      config.datum.heading_deg = 0.0;
+      config.datum = map_->datum()->config();
       ROS_INFO("farm_sim: fixes use the map's datum (%.7f, %.7f)", config.datum.latitude, config.datum.longitude);
     }
   } catch (const std::exception& e) {
@@ -239,7 +236,7 @@ void FarmSimNode::publish(const sim::SimOutputs& out) {
   for (const auto& s : out.scans) {
     sensor_msgs::LaserScan m;
     m.header.stamp = toRos(s.stamp);
-    m.header.frame_id = s.robot_id + "/" + s.frame;
+    m.header.frame_id = s.frame_id;
     m.angle_min = static_cast<float>(s.angle_min);
     m.angle_max = static_cast<float>(s.angle_max);
     m.angle_increment = static_cast<float>(s.angle_increment);
@@ -248,13 +245,13 @@ void FarmSimNode::publish(const sim::SimOutputs& out) {
     m.range_min = static_cast<float>(s.range_min);
     m.range_max = static_cast<float>(s.range_max);
     m.ranges = s.ranges;
-    robots_[s.robot_index].scans[s.frame].publish(m);
+    robots_[s.robot_index].scans[s.mount].publish(m);
     ++n_scan_;
   }
   for (const auto& r : out.rfid) {
     picker_localisation::RfidReading m;
     m.header.stamp = toRos(r.stamp);
-    m.header.frame_id = r.robot_id + "/" + r.frame;
+    m.header.frame_id = r.frame_id;
     m.robot_id = r.robot_id;
     m.tag_id = r.tag_id;
     m.rssi = r.rssi;
@@ -266,7 +263,7 @@ void FarmSimNode::publish(const sim::SimOutputs& out) {
   for (const auto& u : out.uwb) {
     picker_localisation::UwbRange m;
     m.header.stamp = toRos(u.stamp);
-    m.header.frame_id = u.robot_id + "/" + u.frame;
+    m.header.frame_id = u.frame_id;
     m.robot_id = u.robot_id;
     m.tag_id = u.tag_id;
     m.range = u.range;

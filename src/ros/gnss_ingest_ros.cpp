@@ -38,18 +38,14 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   // when the map has none.
   try {
     if (useMapDatum(datum_source, *map_)) {
-      sensors::DatumConfig c;
-      c.kind = sensors::DatumConfig::Kind::kLocalCartesian;
-      c.latitude = map_->datum()->latitude;
-      c.longitude = map_->datum()->longitude;
-      c.altitude = map_->datum()->altitude;
-      datum_ = std::make_unique<sensors::GeodeticDatum>(c);
+      const core::DatumConfig c = map_->datum()->config();
+      datum_ = std::make_unique<core::GeodeticDatum>(c);
       ROS_INFO("gnss_ingest: datum from the map (%.7f, %.7f, %.1f m; ~datum_source file uses %s instead)",
                c.latitude, c.longitude, c.altitude, datum_file.empty() ? "~datum_file" : datum_file.c_str());
     } else {
       if (datum_file.empty())
         throw std::runtime_error("parameter ~datum_file (config/datum.yaml) is required: the map has no datum");
-      datum_ = std::make_unique<sensors::GeodeticDatum>(sensors::GeodeticDatum::load(datum_file));
+      datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file));
       ROS_INFO("gnss_ingest: datum from %s%s", datum_file.c_str(),
                map_->datum() ? " (~datum_source file: the map's own datum is not used)" : "");
     }
@@ -377,7 +373,7 @@ void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped
   ++picker_poses_;
 }
 
-void GnssIngestNode::processFix(Picker& picker, const sensors::GnssFix& fix) {
+void GnssIngestNode::processFix(Picker& picker, const core::GnssFix& fix) {
   sensors::GnssIngest& g = picker.ingest;
   sensors::GnssResult r = g.process(fix);
   if (!r.accepted()) {

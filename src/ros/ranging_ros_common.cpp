@@ -12,7 +12,7 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-sensor_msgs::NavSatFix navSatFixAt(const sensors::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
+sensor_msgs::NavSatFix navSatFixAt(const core::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
                                    const ros::Time& stamp, double sigma) {
   sensor_msgs::NavSatFix f;
   f.header.stamp = stamp;
@@ -28,14 +28,14 @@ sensor_msgs::NavSatFix navSatFixAt(const sensors::GeodeticDatum& datum, const Ei
   return f;
 }
 
-sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg) {
-  sensors::GnssFix f;
+core::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg) {
+  core::GnssFix f;
   f.stamp = msg.header.stamp.toSec();
   f.latitude = msg.latitude;
   f.longitude = msg.longitude;
   f.altitude = msg.altitude;
   f.status = msg.status.status;
-  for (std::size_t i = 0; i < 9; ++i) f.covariance[i] = msg.position_covariance[i];
+  for (std::size_t i = 0; i < 9; ++i) f.position_covariance[i] = msg.position_covariance[i];
   f.covariance_type = msg.position_covariance_type;
   return f;
 }

@@ -70,7 +70,7 @@ void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr
   sensors::RfidRead read;
   read.stamp = msg->header.stamp.toSec();
   read.robot_id = msg->robot_id;
-  read.antenna_id = msg->header.frame_id;
+  read.frame_id = msg->header.frame_id;
   read.tag_id = msg->tag_id;
   read.antenna_pose << p.translation(), std::atan2(p.linear()(1, 0), p.linear()(0, 0));
   read.rssi = msg->rssi;

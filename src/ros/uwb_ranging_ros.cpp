@@ -123,7 +123,7 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
   have_range_ = true;
   in.robot_id = msg->robot_id;
   in.tag_id = msg->tag_id;
-  in.anchor_id = msg->header.frame_id;
+  in.frame_id = msg->header.frame_id;
   in.anchor_in_robot = *anchor;
   in.range = msg->range;
   in.variance = msg->variance;

@@ -9,11 +9,14 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-sensors::LaserScanData toScanData(const sensor_msgs::LaserScan& msg) {
-  sensors::LaserScanData s;
+core::LaserScan toScanData(const sensor_msgs::LaserScan& msg) {
+  core::LaserScan s;
   s.stamp = msg.header.stamp.toSec();
+  s.frame_id = msg.header.frame_id;
   s.angle_min = msg.angle_min;
+  s.angle_max = msg.angle_max;
   s.angle_increment = msg.angle_increment;
+  s.scan_time = msg.scan_time;
   s.range_min = msg.range_min;
   s.range_max = msg.range_max;
   s.ranges = msg.ranges;
@@ -42,7 +45,7 @@ std::vector<BagScan> readBagScans(const std::string& bag_path, const std::vector
 
 std::vector<sensors::LabelledScan> readLabelledLegBag(const std::string& bag_path) {
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
-  std::vector<sensors::LaserScanData> scans;
+  std::vector<core::LaserScan> scans;
   std::vector<std::vector<Eigen::Vector2d>> labels;
   rosbag::View view(bag, rosbag::TopicQuery(std::vector<std::string>{"/training_scan", "/leg_cluster_positions"}));
   for (const auto& m : view) {

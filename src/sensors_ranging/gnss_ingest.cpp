@@ -164,7 +164,7 @@ const char* toString(GnssRejection r) {
 }
 
 GnssIngest::GnssIngest(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map,
-                       GeodeticDatum datum, GnssIngestOptions options)
+                       core::GeodeticDatum datum, GnssIngestOptions options)
     : picker_id_(std::move(picker_id)),
       map_(std::move(map)),
       datum_(std::move(datum)),
@@ -181,7 +181,7 @@ double GnssIngest::ageOfLastFix(double now) const {
   return last_ ? now - last_->stamp : std::numeric_limits<double>::infinity();
 }
 
-GnssResult GnssIngest::process(const GnssFix& fix) {
+GnssResult GnssIngest::process(const core::GnssFix& fix) {
   GnssResult result;
   ++counters_.received;
   auto reject = [&](GnssRejection r, const std::string& why, std::size_t& counter) {
@@ -202,7 +202,8 @@ GnssResult GnssIngest::process(const GnssFix& fix) {
   if (fix.covariance_type <= 0) {
     c_en = Eigen::Matrix2d::Identity() * options_.default_sigma * options_.default_sigma;
   } else {
-    c_en << fix.covariance[0], fix.covariance[1], fix.covariance[3], fix.covariance[4];
+    c_en << fix.position_covariance[0], fix.position_covariance[1], fix.position_covariance[3],
+        fix.position_covariance[4];
     if (!c_en.allFinite())
       return reject(GnssRejection::kNotFinite, "covariance is NaN/Inf", counters_.not_finite);
     if (c_en(0, 0) < 0.0 || c_en(1, 1) < 0.0)

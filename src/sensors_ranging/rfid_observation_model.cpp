@@ -184,7 +184,7 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     s << "RSSI " << read.rssi << " dBm below min_rssi " << options_.min_rssi;
     return reject(RfidRejection::kWeakSignal, s.str(), counters_.weak_signal);
   }
-  auto last = antenna_last_stamp_.find(read.antenna_id);
+  auto last = antenna_last_stamp_.find(read.frame_id);
   if (last != antenna_last_stamp_.end() && read.stamp < last->second - options_.out_of_order_tolerance) {
     std::ostringstream s;
     s << "stamp " << read.stamp << " s is older than the antenna's newest read (" << last->second << " s)";
@@ -192,13 +192,13 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
   }
   // Reading spell of this antenna (for negative information).
   if (last == antenna_last_stamp_.end() || read.stamp - last->second > options_.negative_window)
-    antenna_session_start_[read.antenna_id] = read.stamp;
-  antenna_last_stamp_[read.antenna_id] =
+    antenna_session_start_[read.frame_id] = read.stamp;
+  antenna_last_stamp_[read.frame_id] =
       std::max(read.stamp, last == antenna_last_stamp_.end() ? read.stamp : last->second);
   // Failed attempts of this antenna on this picker's tag since its previous read (see attempt_rate).
   int failed = 0;
   {
-    auto prev = last_read_.find({read.antenna_id, *picker});
+    auto prev = last_read_.find({read.frame_id, *picker});
     if (options_.attempt_rate > 0.0 && logistic_ && prev != last_read_.end()) {
       const double gap = read.stamp - prev->second;
       if (gap > 0.0 && gap <= options_.negative_window)
@@ -206,7 +206,7 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
                             options_.max_failed_attempts);
     }
   }
-  last_read_[{read.antenna_id, *picker}] = read.stamp;
+  last_read_[{read.frame_id, *picker}] = read.stamp;
   ++counters_.accepted;
 
   core::Observation obs;
@@ -237,12 +237,12 @@ std::vector<core::Observation> RfidObservationModel::negativeObservations(const 
                                                                           const std::string& read_picker) {
   std::vector<core::Observation> out;
   // The antenna must have been reading for a whole window before absence of a read means anything.
-  if (read.stamp - antenna_session_start_[read.antenna_id] < options_.negative_window) return out;
+  if (read.stamp - antenna_session_start_[read.frame_id] < options_.negative_window) return out;
   std::vector<topology::NodeIndex> inside;
   bool inside_computed = false;
   for (const core::PickerConfig& p : registry_.pickers()) {
     if (p.id == read_picker || p.rfid_tags.empty()) continue;
-    const std::pair<std::string, std::string> key{read.antenna_id, p.id};
+    const std::pair<std::string, std::string> key{read.frame_id, p.id};
     auto lr = last_read_.find(key);
     if (lr != last_read_.end() && read.stamp - lr->second <= options_.negative_window) continue;
     auto ln = last_negative_.find(key);

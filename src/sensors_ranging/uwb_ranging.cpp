@@ -96,7 +96,7 @@ UwbRejection UwbRanging::addRange(const UwbRangeInput& in, const Eigen::Isometry
   st.last_stamp = in.stamp;
   newest_stamp_ = std::max(newest_stamp_, in.stamp);
   if (st.batch && (in.stamp - st.batch->first_stamp > options_.batch_window ||
-                   std::find(st.batch->anchors.begin(), st.batch->anchors.end(), in.anchor_id) != st.batch->anchors.end()))
+                   std::find(st.batch->anchors.begin(), st.batch->anchors.end(), in.frame_id) != st.batch->anchors.end()))
     processBatch(in.tag_id, st, out);
 
   const double variance = in.variance > 0.0 ? in.variance : options_.rhf.default_range_sigma * options_.rhf.default_range_sigma;
@@ -120,7 +120,7 @@ UwbRejection UwbRanging::addRange(const UwbRangeInput& in, const Eigen::Isometry
   b.last_stamp = in.stamp;
   b.robot_id = in.robot_id;
   b.robot_pose = robot_pose;
-  b.anchors.push_back(in.anchor_id);
+  b.anchors.push_back(in.frame_id);
   b.ranges.push_back({in.anchor_in_robot.translation(), in.range, variance});
   if (in.pdoa_angle && options_.pdoa_mode == "bearing")
     b.pdoa_bearings.push_back({in.anchor_in_robot.translation(), *in.pdoa_angle + anchor_yaw, options_.pdoa_angle_sigma});

@@ -5,18 +5,6 @@
 namespace picker_localisation {
 namespace sensors {
 
-bool LaserScanData::validRange(std::size_t i) const {
-  if (i >= ranges.size()) return false;
-  const double r = ranges[i];
-  return std::isfinite(r) && r >= range_min && r <= range_max && r > 0.0;
-}
-
-std::size_t LaserScanData::validCount() const {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < ranges.size(); ++i) n += validRange(i) ? 1 : 0;
-  return n;
-}
-
 Eigen::Vector2d ScanCluster::centroid() const {
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   if (points.empty()) return c;
@@ -24,7 +12,7 @@ Eigen::Vector2d ScanCluster::centroid() const {
   return c / static_cast<double>(points.size());
 }
 
-std::vector<ScanCluster> segmentScan(const LaserScanData& scan, const SegmentationOptions& options) {
+std::vector<ScanCluster> segmentScan(const core::LaserScan& scan, const SegmentationOptions& options) {
   std::vector<ScanCluster> out;
   if (!std::isfinite(scan.angle_min) || !std::isfinite(scan.angle_increment)) return out;
   ScanCluster current;

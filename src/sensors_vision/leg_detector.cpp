@@ -50,7 +50,7 @@ LegDetector::LegDetector(std::shared_ptr<const LegClassifier> classifier, LegDet
   if (!classifier_ || !classifier_->trained()) throw std::invalid_argument("LegDetector: needs a trained classifier");
 }
 
-LegDetection LegDetector::detect(const LaserScanData& scan) const {
+LegDetection LegDetector::detect(const core::LaserScan& scan) const {
   LegDetection out;
   out.stamp = scan.stamp;
   out.clusters = segmentScan(scan, options_.segmentation);

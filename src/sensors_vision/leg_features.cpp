@@ -37,7 +37,7 @@ bool fitCircle(const std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& centre,
 
 }  // namespace
 
-LegFeatures LegFeatures::compute(const ScanCluster& cluster, const LaserScanData* scan) {
+LegFeatures LegFeatures::compute(const ScanCluster& cluster, const core::LaserScan* scan) {
   LegFeatures f;
   const auto& pts = cluster.points;
   const std::size_t n = pts.size();

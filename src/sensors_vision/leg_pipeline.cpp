@@ -133,7 +133,7 @@ LegPipeline::LegPipeline(std::shared_ptr<const LegClassifier> classifier, LegPip
   if (!problem.empty()) throw std::invalid_argument("LegPipeline: " + problem);
 }
 
-std::vector<PersonCandidate> LegPipeline::scanCandidates(const LaserScanData& scan,
+std::vector<PersonCandidate> LegPipeline::scanCandidates(const core::LaserScan& scan,
                                                          const Eigen::Isometry3d& fixed_from_sensor) const {
   const LegDetection detection = detector_.detect(scan);
   auto toFixed = [&](const Eigen::Vector2d& p) {

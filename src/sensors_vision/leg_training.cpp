@@ -7,7 +7,7 @@
 
 namespace picker_localisation {
 namespace sensors {
-void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<LaserScanData>& negatives,
+void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
                             const LegDetectorOptions& options, double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels) {
   for (const auto& ls : positives) {
@@ -52,7 +52,7 @@ LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<Labell
   return e;
 }
 
-LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<LaserScanData>& scans) {
+LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<core::LaserScan>& scans) {
   LegEvaluation e;
   for (const auto& scan : scans) {
     ++e.scans;

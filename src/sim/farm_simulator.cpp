@@ -50,7 +50,7 @@ struct FarmSimulator::SensorStreams {
 };
 
 FarmSimulator::FarmSimulator(const topology::TopologicalMap& map, SimConfig config)
-    : map_(&map), config_(std::move(config)), layout_(map), projection_(config_.datum) {
+    : map_(&map), config_(std::move(config)), layout_(map), datum_(config_.datum) {
   if (!(config_.time_step > 0.0)) throw std::invalid_argument("FarmSimulator: time_step must be > 0");
   checkRate(config_.gnss.rate, "gnss");
   checkRate(config_.laser.rate, "laser");
@@ -267,7 +267,7 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
     if (!en.gnss) return;
     for (std::size_t i = 0; i < pickers_.size(); ++i) {
       if (!config_.pickers[i].has_gnss) continue;
-      auto fix = makeGnssFix(gnss_[i], projection_, config_.gnss, stamp, pickers_[i].pose().position());
+      auto fix = makeGnssFix(gnss_[i], datum_, config_.gnss, stamp, pickers_[i].pose().position());
       if (!fix) continue;
       fix->picker_id = config_.pickers[i].id;
       fix->picker_index = i;
@@ -279,11 +279,12 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
     for (std::size_t r = 0; r < robots_.size(); ++r) {
       const LaserScene scene = laserScene(r);
       for (const auto& m : layout.lasers) {
-        LaserScan scan =
+        LaserScanWithTruth scan =
             castLaser(scene, robots_[r].pose().compose(m.pose), config_.laser, stamp, streams_[r]->laser);
         scan.robot_id = robots_[r].id();
         scan.robot_index = r;
-        scan.frame = m.frame;
+        scan.mount = m.frame;
+        scan.frame_id = scan.robot_id + "/" + m.frame;
         out.scans.push_back(std::move(scan));
       }
     }
@@ -304,7 +305,8 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
           reading.stamp = stamp;
           reading.robot_id = robots_[r].id();
           reading.robot_index = r;
-          reading.frame = m.frame;
+          reading.mount = m.frame;
+          reading.frame_id = reading.robot_id + "/" + m.frame;
           reading.tag_id = config_.pickers[i].*tag;
           reading.picker_index = i;
           readings.push_back(std::move(reading));
@@ -314,14 +316,15 @@ void FarmSimulator::fireSensors(SimOutputs& out) {
   onTicks(rfid_tick_, config_.rfid.rate, time_, [&](double stamp) {
     if (!en.rfid) return;
     tagSensor(stamp, layout.rfid_antennas, &PickerSpec::rfid_tag, config_.rfid.tag_height,
-              &SensorStreams::rfid, out.rfid, [&](double d, std::mt19937_64& rng, RfidRead& read) {
+              &SensorStreams::rfid, out.rfid,
+              [&](double d, std::mt19937_64& rng, RfidReadingWithTruth& read) {
                 return simulateRfidRead(config_.rfid, d, rng, read);
               });
   });
   onTicks(uwb_tick_, config_.uwb.rate, time_, [&](double stamp) {
     if (!en.uwb) return;
     tagSensor(stamp, layout.uwb_anchors, &PickerSpec::uwb_tag, config_.uwb.tag_height, &SensorStreams::uwb,
-              out.uwb, [&](double d, std::mt19937_64& rng, UwbReading& u) {
+              out.uwb, [&](double d, std::mt19937_64& rng, UwbRangeWithTruth& u) {
                 return simulateUwbRange(config_.uwb, d, rng, u);
               });
   });

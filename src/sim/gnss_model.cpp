@@ -1,7 +1,5 @@
 #include "picker_localisation/sim/gnss_model.h"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -9,60 +7,11 @@
 namespace picker_localisation {
 namespace sim {
 
-MapDatum loadMapDatum(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(path + ": cannot read datum file (" + e.what() + ")");
-  }
-  if (root["datum"]) root = root["datum"];
-  if (!root.IsMap()) throw std::runtime_error(path + ": datum file is not a mapping");
-  MapDatum d;
-  auto get = [&](const char* key, double& out, bool required) {
-    if (!root[key]) {
-      if (required) throw std::runtime_error(path + ": missing key '" + key + "'");
-      return;
-    }
-    try {
-      out = root[key].as<double>();
-    } catch (const std::exception&) {
-      throw std::runtime_error(path + ": key '" + key + "' is not a number");
-    }
-    if (!std::isfinite(out)) throw std::runtime_error(path + ": key '" + key + "' is not finite");
-  };
-  if (root["type"] && root["type"].as<std::string>() != "local_cartesian")
-    throw std::runtime_error(path + ": datum type '" + root["type"].as<std::string>() +
-                             "' is not supported by the simulator (use local_cartesian)");
-  get("latitude", d.latitude, true);
-  get("longitude", d.longitude, true);
-  get("altitude", d.altitude, false);
-  get("heading", d.heading_deg, false);  // older spelling
-  get("heading_deg", d.heading_deg, false);
-  if (std::abs(d.latitude) > 90.0 || std::abs(d.longitude) > 180.0)
-    throw std::runtime_error(path + ": latitude/longitude out of range");
+core::DatumConfig riseholmeDatum() {
+  core::DatumConfig d;  // Riseholme campus, Lincoln (UK), approximately (as config/datum.yaml)
+  d.latitude = 53.268;
+  d.longitude = -0.524;
   return d;
-}
-
-MapProjection::MapProjection(const MapDatum& datum)
-    : datum_(datum), proj_(datum.latitude, datum.longitude, datum.altitude) {
-  const double h = datum.heading_deg * M_PI / 180.0;
-  cos_h_ = std::cos(h);
-  sin_h_ = std::sin(h);
-}
-
-void MapProjection::toGeodetic(const Eigen::Vector2d& map_xy, double z, double& lat, double& lon,
-                               double& alt) const {
-  // Map x axis points at `heading` counter-clockwise from East.
-  const double east = cos_h_ * map_xy.x() - sin_h_ * map_xy.y();
-  const double north = sin_h_ * map_xy.x() + cos_h_ * map_xy.y();
-  proj_.Reverse(east, north, z, lat, lon, alt);
-}
-
-Eigen::Vector2d MapProjection::toMap(double lat, double lon, double alt) const {
-  double east = 0.0, north = 0.0, up = 0.0;
-  proj_.Forward(lat, lon, alt, east, north, up);
-  return {cos_h_ * east + sin_h_ * north, -sin_h_ * east + cos_h_ * north};
 }
 
 GnssErrorModel::GnssErrorModel(const GnssNoiseParams& params, std::uint64_t rng_seed, double start_time)
@@ -115,10 +64,11 @@ std::optional<Eigen::Vector2d> GnssErrorModel::sample(double t) {
   return offset_ + drift_ + white;
 }
 
-std::optional<GnssFix> makeGnssFix(GnssErrorModel& model, const MapProjection& projection,
-                                   const GnssNoiseParams& params, double t, const Eigen::Vector2d& truth) {
+std::optional<GnssFixWithTruth> makeGnssFix(GnssErrorModel& model, const core::GeodeticDatum& datum,
+                                            const GnssNoiseParams& params, double t,
+                                            const Eigen::Vector2d& truth) {
   const auto err = model.sample(t);
-  GnssFix fix;
+  GnssFixWithTruth fix;
   fix.stamp = t;
   fix.true_position = truth;
   if (!err) {
@@ -133,7 +83,7 @@ std::optional<GnssFix> makeGnssFix(GnssErrorModel& model, const MapProjection& p
   }
   fix.error = *err;
   fix.status = 0;
-  projection.toGeodetic(truth + *err, params.antenna_height, fix.latitude, fix.longitude, fix.altitude);
+  datum.toGeodetic(truth + *err, params.antenna_height, fix.latitude, fix.longitude, fix.altitude);
   const double v = params.reported_std * params.reported_std;
   fix.position_covariance = {v, 0, 0, 0, v, 0, 0, 0, 4.0 * v};
   fix.covariance_type = 2;

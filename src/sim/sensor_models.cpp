@@ -34,9 +34,9 @@ double raySegment(const Eigen::Vector2d& origin, const Eigen::Vector2d& dir, con
   return r;
 }
 
-LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params,
-                    double stamp, std::mt19937_64& rng) {
-  LaserScan scan;
+LaserScanWithTruth castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params,
+                             double stamp, std::mt19937_64& rng) {
+  LaserScanWithTruth scan;
   scan.stamp = stamp;
   scan.angle_min = params.angle_min;
   scan.angle_increment = params.angle_increment;
@@ -113,7 +113,7 @@ double rfidReadProbability(const RfidParams& p, double distance) {
   return p.p_max / (1.0 + std::exp((distance - p.d50) / p.width));
 }
 
-bool simulateRfidRead(const RfidParams& p, double distance, std::mt19937_64& rng, RfidRead& out) {
+bool simulateRfidRead(const RfidParams& p, double distance, std::mt19937_64& rng, RfidReadingWithTruth& out) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> n(0.0, 1.0);
   // Fixed number of draws per attempt (determinism does not depend on read outcomes).
@@ -128,7 +128,7 @@ bool simulateRfidRead(const RfidParams& p, double distance, std::mt19937_64& rng
   return true;
 }
 
-bool simulateUwbRange(const UwbParams& p, double distance, std::mt19937_64& rng, UwbReading& out) {
+bool simulateUwbRange(const UwbParams& p, double distance, std::mt19937_64& rng, UwbRangeWithTruth& out) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> n(0.0, 1.0);
   std::exponential_distribution<double> e(1.0);

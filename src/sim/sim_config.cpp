@@ -80,11 +80,12 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                         {"reported_std", set(c.gnss.reported_std)},
                         {"antenna_height", set(c.gnss.antenna_height)}},
                        "gnss")},
-      {"datum", section({{"latitude", set(c.datum.latitude)},
-                         {"longitude", set(c.datum.longitude)},
-                         {"altitude", set(c.datum.altitude)},
-                         {"heading_deg", set(c.datum.heading_deg)}},
-                        "datum")},
+      {"datum",
+       [&c, &source](const YAML::Node& n) {  // config/datum.yaml's keys (core::DatumConfig)
+         std::vector<std::string> unknown;
+         c.datum = core::DatumConfig::fromYaml(n, source, &unknown);
+         if (!unknown.empty()) throw std::runtime_error(unknown.front());
+       }},
       {"robot_motion", section({{"speed", set(c.robot_motion.speed)},
                                 {"patrol",
                                  [&c](const YAML::Node& n) {

@@ -44,7 +44,7 @@
 #include <vector>
 
 #include "picker_localisation/ros/ranging_nodes.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/topology/map_io.h"
 
 namespace fs = std::filesystem;
@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
   const fs::path dir = fs::temp_directory_path() / ("bench_fleet_" + std::to_string(getpid()));
   fs::create_directories(dir);
   pl::topology::TopologicalMap map;
-  pl::sensors::GeodeticDatum datum = pl::sensors::GeodeticDatum::load(a.datum);
+  pl::core::GeodeticDatum datum = pl::core::GeodeticDatum::load(a.datum);
   try {
     map = pl::topology::loadMap(a.map);
   } catch (const std::exception& e) {

@@ -11,6 +11,7 @@
 #include "picker_localisation/sensors_vision/leg_detector.h"
 #include "picker_localisation/sensors_vision/person_box_detector.h"
 
+using namespace picker_localisation;
 using namespace picker_localisation::sensors;
 
 namespace {
@@ -19,8 +20,8 @@ std::string g_model = PL_LEG_MODEL;
 
 // A 10 m x 8 m room seen from its centre with two people (four legs, radius 6 cm) and six table legs; beams
 // over 270 deg with 1 cm range noise (seeded).
-LaserScanData syntheticScan(int beams) {
-  LaserScanData s;
+core::LaserScan syntheticScan(int beams) {
+  core::LaserScan s;
   s.angle_min = -0.75 * M_PI;
   s.angle_increment = 1.5 * M_PI / beams;
   s.range_min = 0.05;

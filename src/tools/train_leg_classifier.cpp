@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
     }
     const auto neg = ros_adapter::readBagScans(data + "/negative_2.bag");
     const std::size_t split = sensors::negativeTrainCount(neg.size());
-    std::vector<sensors::LaserScanData> train_neg, test_neg;
+    std::vector<core::LaserScan> train_neg, test_neg;
     for (std::size_t i = 0; i < neg.size(); ++i) (i < split ? train_neg : test_neg).push_back(neg[i].scan);
 
     sensors::LegDetectorOptions options;

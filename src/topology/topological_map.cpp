@@ -155,6 +155,15 @@ TopologicalMap& TopologicalMap::operator=(const TopologicalMap& other) {
   return *this;
 }
 
+core::DatumConfig MapDatum::config() const {
+  core::DatumConfig c;
+  c.kind = core::DatumConfig::Kind::kLocalCartesian;
+  c.latitude = latitude;
+  c.longitude = longitude;
+  c.altitude = altitude;
+  return c;
+}
+
 void TopologicalMap::setDatum(std::optional<MapDatum> datum) {
   if (datum && (!std::isfinite(datum->latitude) || !std::isfinite(datum->longitude) ||
                 !std::isfinite(datum->altitude) || std::abs(datum->latitude) > 90.0 ||

@@ -41,10 +41,10 @@ namespace picker_localisation {
 namespace ros_adapter {
 
 // sensor_msgs/NavSatFix -> core GnssFix (no checks: GnssIngest does them).
-sensors::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg);
+core::GnssFix gnssFixFromMsg(const sensor_msgs::NavSatFix& msg);
 // A good fix (STATUS_FIX, diagonal covariance sigma^2 horizontally, (2 sigma)^2 vertically, altitude 50 m) at a
 // map position, as a phone would send it (tests, bench_fleet).
-sensor_msgs::NavSatFix navSatFixAt(const sensors::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
+sensor_msgs::NavSatFix navSatFixAt(const core::GeodeticDatum& datum, const Eigen::Vector2d& map_xy,
                                    const ros::Time& stamp, double sigma = 1.0);
 
 // Looks up `target <- source` at `stamp`, waiting at most `timeout` s. nullopt (and *error set) when the
@@ -99,7 +99,7 @@ class GnssIngestNode {
   // subscriptions and bias topic.
   struct Picker {
     Picker(const core::PickerConfig& config, std::shared_ptr<const topology::TopologicalMap> map,
-           const sensors::GeodeticDatum& datum, const sensors::GnssIngestOptions& options)
+           const core::GeodeticDatum& datum, const sensors::GnssIngestOptions& options)
         : config(config), ingest(config.id, std::move(map), datum, options) {}
     core::PickerConfig config;
     sensors::GnssIngest ingest;
@@ -112,7 +112,7 @@ class GnssIngestNode {
     bool is_fix = true;
     bool is_sighting = false;  // an identifying RFID / UWB observation (bias_sighting_sensors)
     std::string picker;        // the fix's picker (looked up on release: it may have been removed meanwhile)
-    sensors::GnssFix fix;
+    core::GnssFix fix;
     core::Observation person;
   };
   void addPicker(const core::PickerConfig& p);
@@ -138,7 +138,7 @@ class GnssIngestNode {
   std::vector<sensors::GnssIngest*> pickerPointers();
   std::vector<const sensors::BeliefHistory*> beliefHistories() const;
   void releaseOrdered();
-  void processFix(Picker& picker, const sensors::GnssFix& fix);
+  void processFix(Picker& picker, const core::GnssFix& fix);
   void processPerson(const core::Observation& person);
   void publishBias(Picker& picker, double stamp, const sensors::GnssResult& r);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -146,7 +146,7 @@ class GnssIngestNode {
   bool ok_ = false;
   ros::NodeHandle nh_;
   std::shared_ptr<const topology::TopologicalMap> map_;
-  std::unique_ptr<sensors::GeodeticDatum> datum_;
+  std::unique_ptr<core::GeodeticDatum> datum_;
   std::string frame_id_, bias_prefix_;
   sensors::GnssIngestOptions options_;
   sensors::IdentityEvidence identity_;  // RFID reads / failed reads per picker (association_identity_sensors)

@@ -1,4 +1,4 @@
-// ROS message / bag adapters of the sensors_vision area: LaserScan -> LaserScanData, and the labelled leg bags
+// ROS message / bag adapters of the sensors_vision area: LaserScan -> core::LaserScan, and the labelled leg bags
 // of ../shared/data/leg_tracker (rosbag C++ API, no master needed).
 #pragma once
 
@@ -12,12 +12,12 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-sensors::LaserScanData toScanData(const sensor_msgs::LaserScan& msg);
+core::LaserScan toScanData(const sensor_msgs::LaserScan& msg);
 
 struct BagScan {
   std::string topic;
   std::string frame_id;
-  sensors::LaserScanData scan;
+  core::LaserScan scan;
 };
 
 // Every sensor_msgs/LaserScan in the bag, in recording order; `topics` empty: all LaserScan topics.

@@ -1,6 +1,6 @@
 // GNSS fixes of one picker -> identifying Observations over map nodes (Navigate-and-Seek Sec. IV/VI; outlier
-// gating after seed 002). ROS-free: the node converts sensor_msgs/NavSatFix into GnssFix, and the offline
-// experiment runner can feed GnssFix directly.
+// gating after seed 002). ROS-free: the node converts sensor_msgs/NavSatFix into core::GnssFix, and the
+// offline experiment runner feeds the simulator's core::GnssFix directly.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -16,23 +16,13 @@
 #include <vector>
 
 #include "picker_localisation/core/observation.h"
-#include "picker_localisation/sensors_ranging/geodetic_datum.h"
+#include "picker_localisation/core/sensor_data.h"
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_bias.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
 namespace sensors {
-
-// A GNSS fix as in sensor_msgs/NavSatFix, without ROS types.
-struct GnssFix {
-  double stamp = 0.0;       // s, the fix's own time stamp
-  double latitude = 0.0;    // deg WGS84
-  double longitude = 0.0;   // deg WGS84
-  double altitude = 0.0;    // m (NaN allowed: not used for the horizontal position then)
-  int status = 0;           // NavSatStatus: -1 NO_FIX, 0 FIX, 1 SBAS_FIX, 2 GBAS_FIX
-  std::array<double, 9> covariance{};  // row-major ENU position covariance, m^2
-  int covariance_type = 0;  // 0 UNKNOWN, 1 APPROXIMATED, 2 DIAGONAL_KNOWN, 3 KNOWN
-};
 
 enum class GnssRejection {
   kNone = 0,
@@ -139,10 +129,10 @@ struct GnssCounters {
 // the window, (p_last - p_first) / (t_last - t_first) (= the time-weighted mean of the step velocities).
 class GnssIngest {
  public:
-  GnssIngest(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map, GeodeticDatum datum,
+  GnssIngest(std::string picker_id, std::shared_ptr<const topology::TopologicalMap> map, core::GeodeticDatum datum,
              GnssIngestOptions options = {});
 
-  GnssResult process(const GnssFix& fix);
+  GnssResult process(const core::GnssFix& fix);
 
   // A metric sighting of this picker (position, covariance, map frame) by an identifying sensor or an
   // associated people detection at time `stamp`: pairs it with the raw fix nearest in time (within
@@ -168,7 +158,7 @@ class GnssIngest {
 
   const GnssCounters& counters() const { return counters_; }
   const std::string& pickerId() const { return picker_id_; }
-  const GeodeticDatum& datum() const { return datum_; }
+  const core::GeodeticDatum& datum() const { return datum_; }
   const GnssIngestOptions& options() const { return options_; }
 
  private:
@@ -180,7 +170,7 @@ class GnssIngest {
   };
   std::string picker_id_;
   std::shared_ptr<const topology::TopologicalMap> map_;
-  GeodeticDatum datum_;
+  core::GeodeticDatum datum_;
   GnssIngestOptions options_;
   std::deque<Accepted> window_;     // last accepted fixes (newest at the back)
   std::deque<Accepted> recent_;     // last raw fixes for pairing sightings (kept through blackouts)

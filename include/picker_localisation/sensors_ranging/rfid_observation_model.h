@@ -39,19 +39,15 @@
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/core/sensor_data.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
 namespace sensors {
 
-// One read, antenna pose already resolved into the map frame.
-struct RfidRead {
-  double stamp = 0.0;          // s
-  std::string robot_id;
-  std::string antenna_id;      // antenna frame name
-  std::string tag_id;
+// One read (core::RfidReading) with its antenna's pose resolved into the map frame (tf, or the simulator).
+struct RfidRead : core::RfidReading {
   Eigen::Vector3d antenna_pose = Eigen::Vector3d::Zero();  // x, y (m), yaw (rad) in the map frame
-  double rssi = 0.0;           // dBm
 };
 
 enum class RfidRejection { kNone = 0, kUnknownTag, kNotFinite, kWeakSignal, kOutOfOrder };

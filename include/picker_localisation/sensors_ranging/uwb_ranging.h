@@ -15,6 +15,7 @@
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
+#include "picker_localisation/core/sensor_data.h"
 #include "picker_localisation/sensors_ranging/range_histogram_filter.h"
 #include "picker_localisation/topology/topological_map.h"
 
@@ -34,16 +35,9 @@ double pathDifferenceFromPhase(double phase_difference, double wavelength);
 Eigen::Vector2d relativePositionFromAngle(double r, double angle);
 Eigen::Matrix2d relativePositionCovariance(double r, double angle, double range_variance, double angle_sigma);
 
-// One range, as the node / simulator provides it.
-struct UwbRangeInput {
-  double stamp = 0.0;        // s
-  std::string robot_id;
-  std::string tag_id;
-  std::string anchor_id;     // anchor frame name
+// One range (core::UwbRange) with its anchor's mount on the robot (tf, or the simulator).
+struct UwbRangeInput : core::UwbRange {
   Eigen::Isometry2d anchor_in_robot = Eigen::Isometry2d::Identity();  // anchor mount in base_link
-  double range = 0.0;        // m
-  double variance = 0.0;     // m^2 (<= 0: configured default)
-  std::optional<double> pdoa_angle;  // rad in the anchor frame, positive to the left
 };
 
 // Camera detections of one image (non-identifying bearings), robot frame.

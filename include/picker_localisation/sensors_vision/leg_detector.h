@@ -52,7 +52,7 @@ std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOpti
 class LegDetector {
  public:
   LegDetector(std::shared_ptr<const LegClassifier> classifier, LegDetectorOptions options = {});
-  LegDetection detect(const LaserScanData& scan) const;
+  LegDetection detect(const core::LaserScan& scan) const;
   const LegDetectorOptions& options() const { return options_; }
 
  private:

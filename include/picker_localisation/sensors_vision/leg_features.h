@@ -24,7 +24,7 @@ struct LegFeatures {
   // 10 occluded flag: a neighbouring beam is nearer than the cluster edge (0/1)
   std::array<float, kCount> values{};
 
-  static LegFeatures compute(const ScanCluster& cluster, const LaserScanData* scan = nullptr);
+  static LegFeatures compute(const ScanCluster& cluster, const core::LaserScan* scan = nullptr);
   static std::string name(int i);
 };
 

@@ -81,14 +81,14 @@ class LegPipeline {
 
   // Candidates of one laser scan: people of the leg detector and, with camera_fusion, every other cluster of
   // person size; `fixed_from_sensor` maps the scan frame into the fixed frame.
-  std::vector<PersonCandidate> scanCandidates(const LaserScanData& scan,
+  std::vector<PersonCandidate> scanCandidates(const core::LaserScan& scan,
                                               const Eigen::Isometry3d& fixed_from_sensor) const;
   // Tracks (in `source_frame`'s own tracker), fuses and filters one scan's / cloud's candidates.
   std::vector<TrackedPerson> track(const std::string& source_frame, double stamp,
                                    const std::vector<PersonCandidate>& candidates,
                                    const CameraCones* camera = nullptr);
   std::vector<TrackedPerson> processScan(const std::string& source_frame, double stamp,
-                                         const LaserScanData& scan,
+                                         const core::LaserScan& scan,
                                          const Eigen::Isometry3d& fixed_from_sensor,
                                          const CameraCones* camera = nullptr) {
     return track(source_frame, stamp, scanCandidates(scan, fixed_from_sensor), camera);

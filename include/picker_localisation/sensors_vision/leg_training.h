@@ -12,7 +12,7 @@ namespace picker_localisation {
 namespace sensors {
 
 struct LabelledScan {
-  LaserScanData scan;
+  core::LaserScan scan;
   std::vector<Eigen::Vector2d> legs;  // labelled leg positions, scan frame, m
 };
 
@@ -21,7 +21,7 @@ struct LabelledScan {
 // the positive recordings; the labelling tool marked the legs of the person in view), the rest are skipped.
 // Every cluster of the negative scans is a negative. Clusters failing the detector's range/width gates are skipped, as the detector never classifies
 // them.
-void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<LaserScanData>& negatives,
+void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
                             const LegDetectorOptions& options, double match_distance,
                             double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels);
@@ -37,7 +37,7 @@ struct LegEvaluation {
 // Leg detections vs labels, matched one-to-one (Munkres on distance, pairs beyond hit_distance rejected).
 LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans, double hit_distance);
 // Scans with no people: every leg detected is false.
-LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<LaserScanData>& scans);
+LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<core::LaserScan>& scans);
 
 }  // namespace sensors
 }  // namespace picker_localisation

@@ -63,7 +63,7 @@ struct SimConfig {
   std::vector<std::string> robot_start_nodes;  // node names; empty / missing: spread over lane ends
   PickerMotionParams picker_motion;
   GnssNoiseParams gnss;
-  MapDatum datum;
+  core::DatumConfig datum = riseholmeDatum();
   RobotMotionParams robot_motion;
   RobotSensorLayout sensor_layout;
   LaserParams laser;
@@ -101,7 +101,7 @@ class FarmSimulator {
   const topology::TopologicalMap& map() const { return *map_; }
   const SimConfig& config() const { return config_; }
   const LaneLayout& laneLayout() const { return layout_; }
-  const MapProjection& projection() const { return projection_; }
+  const core::GeodeticDatum& datum() const { return datum_; }
 
   std::size_t numPickers() const { return pickers_.size(); }
   const PickerSpec& pickerSpec(std::size_t i) const { return config_.pickers.at(i); }
@@ -135,7 +135,7 @@ class FarmSimulator {
   const topology::TopologicalMap* map_;
   SimConfig config_;
   LaneLayout layout_;
-  MapProjection projection_;
+  core::GeodeticDatum datum_;
   double time_ = 0.0;
   std::vector<SimulatedPicker> pickers_;
   std::vector<GnssErrorModel> gnss_;

@@ -1,5 +1,5 @@
-// Low-cost GNSS error model of Navigate-and-Seek Table I and the map datum that turns map metres into
-// WGS84 fixes (GeographicLib LocalCartesian). ROS-free.
+// Low-cost GNSS error model of Navigate-and-Seek Table I; fixes in WGS84 through the map's
+// core::GeodeticDatum. ROS-free.
 //
 // Error added to the true map position p at time t, per axis (x, y of the map frame):
 //   fix = p + offset + drift(t) + white(t)
@@ -17,9 +17,8 @@
 // The reported covariance is diagonal with reported_std^2 on east/north and (2 reported_std)^2 on up.
 #pragma once
 
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/sim/sim_types.h"
-
-#include <GeographicLib/LocalCartesian.hpp>
 
 #include <optional>
 #include <random>
@@ -28,36 +27,9 @@
 namespace picker_localisation {
 namespace sim {
 
-// Where the map frame sits on the Earth. Same keys and convention as config/datum.yaml (sensors_ranging
-// GeodeticDatum, type local_cartesian): latitude, longitude (deg, WGS84, of the map origin), altitude (m),
-// heading_deg (deg: yaw of the map x axis counter-clockwise from East; 0 means map x = East, map y = North).
-struct MapDatum {
-  double latitude = 53.268;  // Riseholme campus, Lincoln (UK), approximately (as config/datum.yaml)
-  double longitude = -0.524;
-  double altitude = 0.0;
-  double heading_deg = 0.0;
-};
-
-// Reads a datum file such as config/datum.yaml (`latitude`, `longitude`, `altitude`, `heading_deg` keys,
-// optionally under a top-level `datum:` mapping; `type` must be local_cartesian when present). Throws
-// std::runtime_error with one line naming the file and the key on a bad file.
-MapDatum loadMapDatum(const std::string& path);
-
-// Map metres <-> WGS84 through GeographicLib::LocalCartesian at the datum.
-class MapProjection {
- public:
-  explicit MapProjection(const MapDatum& datum);
-  // (lat deg, lon deg, alt m) of a map point at height z.
-  void toGeodetic(const Eigen::Vector2d& map_xy, double z, double& lat, double& lon, double& alt) const;
-  // Map point of a geodetic position (inverse of toGeodetic).
-  Eigen::Vector2d toMap(double lat, double lon, double alt = 0.0) const;
-  const MapDatum& datum() const { return datum_; }
-
- private:
-  MapDatum datum_;
-  GeographicLib::LocalCartesian proj_;
-  double cos_h_ = 1.0, sin_h_ = 0.0;
-};
+// Where the map frame sits on the Earth: core::GeodeticDatum (config/datum.yaml, or the `datum:` section of
+// config/sim.yaml with the same keys). The simulator's default is Riseholme, as config/datum.yaml.
+core::DatumConfig riseholmeDatum();
 
 struct GnssNoiseParams {
   double offset_min = 0.0;                // m, per-axis constant offset ~ U(offset_min, offset_max)
@@ -103,8 +75,9 @@ class GnssErrorModel {
 
 // Builds the fix a picker's unit reports at time t for true map position `truth` (error from `model`).
 // Returns nullopt during a blackout when params.blackout_emits_no_fix is false.
-std::optional<GnssFix> makeGnssFix(GnssErrorModel& model, const MapProjection& projection,
-                                   const GnssNoiseParams& params, double t, const Eigen::Vector2d& truth);
+std::optional<GnssFixWithTruth> makeGnssFix(GnssErrorModel& model, const core::GeodeticDatum& datum,
+                                            const GnssNoiseParams& params, double t,
+                                            const Eigen::Vector2d& truth);
 
 }  // namespace sim
 }  // namespace picker_localisation

@@ -45,8 +45,8 @@ struct LaserParams {
 // segments), adds N(0, range_noise_std^2) to each hit (one draw per beam, hit or not). REP 117: +inf when
 // nothing is hit within range_max, -inf when the noisy hit is closer than range_min. The robot's own body is
 // not in the scene (the corner lasers look outwards).
-LaserScan castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params,
-                    double stamp, std::mt19937_64& rng);
+LaserScanWithTruth castLaser(const LaserScene& scene, const Pose2D& sensor_pose, const LaserParams& params,
+                             double stamp, std::mt19937_64& rng);
 
 // ---- Static clutter ------------------------------------------------------------------------------------
 struct ClutterParams {
@@ -78,7 +78,8 @@ struct RfidParams {
 };
 double rfidReadProbability(const RfidParams& params, double distance);
 // One read attempt; false when the tag was not read (then `out` is untouched).
-bool simulateRfidRead(const RfidParams& params, double distance, std::mt19937_64& rng, RfidRead& out);
+bool simulateRfidRead(const RfidParams& params, double distance, std::mt19937_64& rng,
+                      RfidReadingWithTruth& out);
 
 // ---- UWB -----------------------------------------------------------------------------------------------
 // Two-way ranging between an anchor and a tag, 3D distance d:
@@ -94,7 +95,7 @@ struct UwbParams {
   double tag_height = 1.0;  // m
   double rate = 10.0;       // Hz, ranges per anchor and tag
 };
-bool simulateUwbRange(const UwbParams& params, double distance, std::mt19937_64& rng, UwbReading& out);
+bool simulateUwbRange(const UwbParams& params, double distance, std::mt19937_64& rng, UwbRangeWithTruth& out);
 
 // ---- Camera --------------------------------------------------------------------------------------------
 // Pinhole camera, body frame x forward / y left / z up at height `mount.z`; the picker is an upright box of

@@ -1,9 +1,11 @@
 // Plain data types produced by the farm simulator: poses, GNSS fixes, laser scans, RFID reads, UWB ranges and
-// camera detections. They mirror the ROS messages field by field (the farm_sim node only copies them), so
-// the simulator core and the offline experiment runner need no ROS. ROS-free.
+// camera detections, each the core raw measurement plus its ground truth (the farm_sim node only copies them
+// into messages), so the simulator core and the offline experiment runner need no ROS. ROS-free.
 #pragma once
 
 #include <Eigen/Core>
+
+#include "picker_localisation/core/sensor_data.h"
 
 #include <array>
 #include <cstddef>
@@ -27,64 +29,41 @@ struct Pose2D {
   Pose2D compose(const Pose2D& child) const;
 };
 
-// sensor_msgs/NavSatFix without the header type (status: -1 NO_FIX, 0 FIX, as sensor_msgs/NavSatStatus).
-struct GnssFix {
-  double stamp = 0.0;  // simulated time, s
+// The raw measurements are core's (core/sensor_data.h), as the nodes' message conversions produce them; the
+// simulator adds the ground truth behind each one for tests and the evaluator (it never reaches an
+// estimator). frame_id carries the robot prefix as the published header does ("robot_1/laser_front"); `mount`
+// is the sensor's name in the sensor layout ("laser_front").
+
+// A fix of a picker's unit (status -1 NO_FIX during a blackout: lat/lon/alt are NaN then).
+struct GnssFixWithTruth : core::GnssFix {
   std::string picker_id;
   std::size_t picker_index = 0;
-  int status = 0;          // 0 STATUS_FIX, -1 STATUS_NO_FIX (blackout; lat/lon/alt are NaN then)
-  double latitude = 0.0;   // deg (WGS84)
-  double longitude = 0.0;  // deg
-  double altitude = 0.0;   // m above the ellipsoid
-  std::array<double, 9> position_covariance{};  // ENU, m^2, row-major
-  int covariance_type = 2;                      // 0 unknown, 1 approximated, 2 diagonal known, 3 known
-  // Ground truth for tests and the evaluator (never published as the fix): the error-free position and the
-  // error actually added (offset + drift + white noise), map frame, m.
+  // The error-free position and the error actually added (offset + drift + white noise), map frame, m.
   Eigen::Vector2d true_position{0.0, 0.0};
   Eigen::Vector2d error{0.0, 0.0};
   bool in_blackout = false;
 };
 
-// sensor_msgs/LaserScan (no intensities). Ranges are +inf where a beam hits nothing within range_max
-// (REP 117).
-struct LaserScan {
-  double stamp = 0.0;
+// A scan of one of a robot's lasers (ranges +inf where a beam hits nothing within range_max, REP 117).
+struct LaserScanWithTruth : core::LaserScan {
   std::string robot_id;
   std::size_t robot_index = 0;
-  std::string frame;             // laser frame without the robot prefix: "laser_front" / "laser_rear"
-  double angle_min = 0.0;        // rad
-  double angle_max = 0.0;        // rad
-  double angle_increment = 0.0;  // rad
-  double range_min = 0.0;        // m
-  double range_max = 0.0;        // m
-  double scan_time = 0.0;        // s between scans
-  std::vector<float> ranges;     // m
-  Pose2D sensor_pose;            // laser pose in the map frame at the stamp (ground truth)
+  std::string mount;   // "laser_front" / "laser_rear"
+  Pose2D sensor_pose;  // laser pose in the map frame at the stamp (ground truth)
 };
 
-// picker_localisation/RfidReading.
-struct RfidRead {
-  double stamp = 0.0;
-  std::string robot_id;
+// A read of a picker's tag by one of a robot's antennas.
+struct RfidReadingWithTruth : core::RfidReading {
   std::size_t robot_index = 0;
-  std::string frame;  // antenna frame without the robot prefix: "rfid_left" / "rfid_right"
-  std::string tag_id;
-  double rssi = 0.0;  // dBm
-  bool has_phase = true;
-  double phase = 0.0;            // rad in [0, 2 pi)
+  std::string mount;             // "rfid_left" / "rfid_right"
   std::size_t picker_index = 0;  // ground truth
   double true_distance = 0.0;    // m, antenna to tag (ground truth)
 };
 
-// picker_localisation/UwbRange.
-struct UwbReading {
-  double stamp = 0.0;
-  std::string robot_id;
+// A range from one of a robot's UWB anchors to a picker's tag.
+struct UwbRangeWithTruth : core::UwbRange {
   std::size_t robot_index = 0;
-  std::string frame;  // anchor frame without the robot prefix: "uwb_anchor_1" ...
-  std::string tag_id;
-  double range = 0.0;            // m
-  double variance = 0.0;         // m^2 (the configured white-noise variance)
+  std::string mount;             // "uwb_anchor_1" ...
   std::size_t picker_index = 0;  // ground truth
   double true_range = 0.0;       // m
   bool nlos = false;             // ground truth: this range carries a non-line-of-sight excess delay
@@ -116,10 +95,10 @@ struct CameraFrame {
 
 // Everything the simulator produced during one step (or one advanceTo), in time order per sensor.
 struct SimOutputs {
-  std::vector<GnssFix> gnss;
-  std::vector<LaserScan> scans;
-  std::vector<RfidRead> rfid;
-  std::vector<UwbReading> uwb;
+  std::vector<GnssFixWithTruth> gnss;
+  std::vector<LaserScanWithTruth> scans;
+  std::vector<RfidReadingWithTruth> rfid;
+  std::vector<UwbRangeWithTruth> uwb;
   std::vector<CameraFrame> camera;
   void clear();
   void append(SimOutputs&& other);

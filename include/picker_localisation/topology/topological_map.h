@@ -14,6 +14,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "picker_localisation/core/geodetic_datum.h"
+
 namespace picker_localisation {
 namespace topology {
 
@@ -67,6 +69,8 @@ struct MapDatum {
   double latitude = 0.0;   // deg WGS84
   double longitude = 0.0;  // deg WGS84
   double altitude = 0.0;   // m
+  // As a core::GeodeticDatum: local_cartesian at that point, map x east (heading 0).
+  core::DatumConfig config() const;
 };
 
 struct BoundingBox {
