@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "diagnostics_rostest_util.h"
 #include "picker_localisation/PickerBelief.h"
 #include "picker_localisation/PickerBeliefArray.h"
 #include "picker_localisation/TrackingError.h"
@@ -100,6 +101,17 @@ TEST(EvaluatorNode, HandComputedErrorsAndBadInput) {
     EXPECT_EQ(err.true_node, "WayPoint2");
     EXPECT_TRUE(std::isfinite(err.euclidean_error));
   }
+}
+
+// After the test above (truth and beliefs received): the inputs status counts them.
+TEST(EvaluatorNode, PublishesDiagnosticsWithInputRates) {
+  ros::NodeHandle nh;
+  const auto seen = diagnostics_test::collect(nh, {"/evaluator"}, 10.0);
+  ASSERT_TRUE(seen.count("/evaluator") && seen.at("/evaluator").count("inputs"));
+  bool truth = false;
+  for (const auto& kv : seen.at("/evaluator").at("inputs").values)
+    if (kv.key == "ground truth received / rate [Hz] / newest [s ago]") truth = kv.value.rfind("0 / ", 0) != 0;
+  EXPECT_TRUE(truth) << "the ground truth sent above is not counted";
 }
 
 int main(int argc, char** argv) {

@@ -16,6 +16,7 @@
 #include <map>
 #include <mutex>
 
+#include "diagnostics_rostest_util.h"
 #include "picker_localisation/topology/map_io.h"
 
 using namespace picker_localisation;
@@ -158,6 +159,14 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   // It took about the path length at 1 m/s of simulated time (not less).
   EXPECT_GE((ros::Time::now() - sent).toSec(), travel - 1.0);
   EXPECT_GT((t1 - t0).toSec(), 9.9);
+}
+
+TEST(FarmSim, PublishesDiagnostics) {
+  ros::NodeHandle nh;
+  const auto seen = diagnostics_test::collect(nh, {"/farm_sim"}, 20.0);
+  ASSERT_TRUE(seen.count("/farm_sim"));
+  EXPECT_TRUE(seen.at("/farm_sim").count("simulation"));
+  EXPECT_TRUE(seen.at("/farm_sim").count("inputs"));  // goals
 }
 
 int main(int argc, char** argv) {

@@ -87,7 +87,8 @@ picker_localisation::PickerBeliefArray g_fleet;
 void diagnosticsCallback(const diagnostic_msgs::DiagnosticArray::ConstPtr& msg) {
   std::lock_guard<std::mutex> lock(g_mutex);
   for (const auto& s : msg->status)
-    if (s.name.find("nbs_planner") != std::string::npos) g_diagnostics[s.hardware_id] = s;
+    if (s.name.size() > 13 && s.name.compare(s.name.size() - 13, 13, ": nbs_planner") == 0)  // not ": inputs"
+      g_diagnostics[s.hardware_id] = s;
 }
 
 void markerCallback(const visualization_msgs::MarkerArray::ConstPtr& m) {

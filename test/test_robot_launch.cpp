@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <set>
 
+#include "diagnostics_rostest_util.h"
+
 namespace {
 std::set<std::string> nodes() {
   std::vector<std::string> v;
@@ -62,6 +64,40 @@ TEST(RobotLaunch, OutputsAdvertisedAndNoSimulation) {
   for (const auto& i : infos) {
     EXPECT_NE(i.name, "/clock");
     EXPECT_EQ(i.name.find("ground_truth"), std::string::npos) << i.name;
+  }
+}
+
+// Every node of the suite reports on /diagnostics (the nodes the master knows, so a node added to robot.launch
+// without diagnostics fails here), and the sensor front-ends report the rate of their inputs.
+TEST(RobotLaunch, EveryNodePublishesDiagnostics) {
+  ros::NodeHandle nh;
+  std::set<std::string> nodes;
+  for (int i = 0; i < 60 && ros::ok() && nodes.size() < 9; ++i) {  // all nine up (robot_state_publisher too)
+    nodes = diagnostics_test::graphNodes({"/rosout"});
+    ros::WallDuration(1.0).sleep();
+  }
+  // Not ours: robot_state_publisher (Debian's) has no diagnostics.
+  nodes.erase("/robot_1/robot_state_publisher");
+  ASSERT_GE(nodes.size(), 8u);
+  const auto seen = diagnostics_test::collect(nh, nodes, 30.0);
+  for (const auto& n : nodes) EXPECT_TRUE(seen.count(n)) << n << " publishes nothing on /diagnostics";
+  // The inputs status with its rate line, before any input arrived.
+  for (const auto& [node, input] : std::vector<std::pair<std::string, std::string>>{
+           {"/robot_1/leg_detector", "scans"},
+           {"/robot_1/camera_detector", "images"},
+           {"/gnss_ingest", "fixes"},
+           {"/tpf_tracker", "observations"},
+           {"/robot_1/nbs_planner", "beliefs"}}) {
+    if (!seen.count(node) || !seen.at(node).count("inputs")) {
+      ADD_FAILURE() << node << " has no inputs status";
+      continue;
+    }
+    const auto& st = seen.at(node).at("inputs");
+    bool found = false;
+    for (const auto& kv : st.values)
+      if (kv.key == input + " received / rate [Hz] / newest [s ago]") found = kv.value.rfind("0 / ", 0) == 0;
+    EXPECT_TRUE(found) << node << ": no '" << input << "' line with 0 received";
+    EXPECT_EQ(st.level, diagnostic_msgs::DiagnosticStatus::OK) << node << ": " << st.message;
   }
 }
 

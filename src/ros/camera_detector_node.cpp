@@ -47,8 +47,8 @@ CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   debug_pub_ = nh_.advertise<sensor_msgs::Image>("debug_image", 1);
   diagnostics_.setHardwareID(robot_id_.empty() ? "camera_detector" : robot_id_);
   diagnostics_.add("camera detector", this, &CameraDetectorNode::diagnose);
-  // The updater publishes only when update() is called (it was never called: nothing on /diagnostics).
-  diagnostics_timer_.start(nh_, diagnostics_);
+  diagnostics_.input("images", 5.0);
+  diagnostics_.start(nh_);
   ok_ = true;
   ROS_INFO("%s: %s detector, at most %.1f Hz", ros::this_node::getName().c_str(), onnx.empty() ? "HOG" : "ONNX",
            max_rate_);
@@ -57,6 +57,7 @@ CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 void CameraDetectorNode::infoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg) { info_ = msg; }
 
 void CameraDetectorNode::imageCallback(const sensor_msgs::Image::ConstPtr& msg) {
+  diagnostics_.tick("images");
   ++received_;
   const ros::Time stamp = msg->header.stamp;
   if (stamp_guard_.tooFarInFuture(stamp)) {

@@ -53,7 +53,9 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   beliefs_->follow(registry.ids());
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
-  diagnostics_timer_.start(nh, diagnostics_);
+  diagnostics_.input("ground truth", 5.0);
+  diagnostics_.input("beliefs");
+  diagnostics_.start(nh);
   sample_period_ = 1.0 / sample_rate;
   // The timer only polls; samples fall on the stamp grid (see the header).
   timer_ = nh.createTimer(ros::Duration(std::min(sample_period_, 0.1)), &Evaluator::onTimer, this);
@@ -66,6 +68,7 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void Evaluator::onBelief(const picker_localisation::PickerBelief& belief) {
+  diagnostics_.tick("beliefs");
   const auto found = index_.find(belief.picker_id);
   if (found == index_.end()) return;  // a picker this evaluation does not score
   Picker& p = pickers_[found->second];
@@ -87,6 +90,7 @@ void Evaluator::onBelief(const picker_localisation::PickerBelief& belief) {
 }
 
 void Evaluator::onTruth(std::size_t i, const geometry_msgs::PoseStamped::ConstPtr& msg) {
+  diagnostics_.tick("ground truth");
   Picker& p = pickers_[i];
   ++p.truths;
   const Eigen::Vector2d t(msg->pose.position.x, msg->pose.position.y);

@@ -168,9 +168,9 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
         ns + "/goal", 10, [this, r](const picker_localisation::GoalNode::ConstPtr& m) { onGoal(r, m); });
     robots_.push_back(std::move(io));
   }
-  diag_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_);
-  diag_->setHardwareID("farm_sim");
-  diag_->add("simulation", this, &FarmSimNode::diagnose);
+  diagnostics_.setHardwareID("farm_sim");
+  diagnostics_.add("simulation", this, &FarmSimNode::diagnose);
+  diagnostics_.input("goals");
   ROS_INFO(
       "farm_sim: map '%s' (%zu nodes, %zu lanes), %zu pickers, %zu robots, seed %llu, rate factor %.1f, "
       "duration %.0f s",
@@ -293,6 +293,7 @@ void FarmSimNode::publish(const sim::SimOutputs& out) {
 }
 
 void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode::ConstPtr& msg) {
+  diagnostics_.tick("goals");
   const std::string& id = sim_->robot(robot).id();
   if (!msg->robot_id.empty() && msg->robot_id != id) {
     ++goals_rejected_;
@@ -345,7 +346,7 @@ void FarmSimNode::tick() {
     last_truth_ = sim_->time();
   }
   publish(out);
-  diag_->update();
+  diagnostics_.publish();  // each step: farm_sim drives the clock
 }
 
 void FarmSimNode::run() {

@@ -102,10 +102,11 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   if (pickers_.empty()) ROS_WARN("gnss_ingest: no picker in ~pickers_file has a gnss_topic");
   ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
-  updater_.setHardwareID("gnss_ingest");
+  diagnostics_.setHardwareID("gnss_ingest");
   silence_.configure(pnh, "GNSS fixes");
-  updater_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
-  diag_timer_.start(nh, updater_);
+  diagnostics_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
+  for (const char* input : {"fixes", "people", "identifying observations", "beliefs"}) diagnostics_.input(input);
+  diagnostics_.start(nh);
   ok_ = true;
 }
 
@@ -188,6 +189,7 @@ bool GnssIngestNode::checkClock() {
 }
 
 void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker) {
+  diagnostics_.tick("fixes");
   checkClock();
   silence_.heard();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
@@ -206,6 +208,7 @@ void GnssIngestNode::onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* 
 }
 
 void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& msg) {
+  diagnostics_.tick("people");
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: person observation stamped %.3f is more than %.1f s ahead of the clock",
@@ -247,6 +250,7 @@ void GnssIngestNode::acceptPerson(core::Observation person, const std::string& k
 }
 
 void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
+  diagnostics_.tick("identifying observations");
   // Cheap filter before converting: this topic carries every observation of the fleet.
   const bool evidence = options_.association.enabled && options_.association.isIdentitySensor(msg->sensor);
   if (!msg->identifying || !(evidence || options_.bias.isSightingSensor(msg->sensor))) return;
@@ -270,6 +274,7 @@ void GnssIngestNode::useIdentified(const core::Observation& obs) {
 }
 
 void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
+  diagnostics_.tick("beliefs");
   const auto it = by_id_.find(msg.picker_id);
   if (it == by_id_.end()) return;  // a picker without GNSS here
   std::vector<topology::NodeIndex> nodes;

@@ -94,8 +94,8 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
 
   diagnostics_.setHardwareID(robot_id_.empty() ? "leg_detector" : robot_id_);
   diagnostics_.add("leg detector", this, &LegDetectorNode::diagnose);
-  // The updater publishes only when update() is called (it was never called: nothing on /diagnostics).
-  diagnostics_timer_.start(nh_, diagnostics_);
+  diagnostics_.input("scans", 2.0);
+  diagnostics_.start(nh_);
   ok_ = true;
   ROS_INFO("%s: %zu scan topic(s), model %s, fixed frame %s%s", ros::this_node::getName().c_str(),
            scan_topics.size(), model.c_str(), fixed_frame_.c_str(),
@@ -135,6 +135,7 @@ bool LegDetectorNode::acceptStamp(const ros::Time& stamp, const char* what) {
 }
 
 void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) {
+  diagnostics_.tick("scans");
   ++scans_;
   if (!acceptStamp(msg->header.stamp, "scan")) return;
   if (msg->header.frame_id.empty()) {
@@ -162,6 +163,7 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
 }
 
 void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
+  diagnostics_.tick("clouds");
   ++clouds_;
   if (!acceptStamp(msg->header.stamp, "cloud")) return;
   // Validate the cloud against its own metadata before reading its data (pcl::fromROSMsg trusts it).
@@ -193,6 +195,7 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
 }
 
 void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
+  diagnostics_.tick("camera detections");
   ++camera_frames_;
   if (!acceptStamp(msg->header.stamp, "camera detections")) return;
   for (const auto& d : msg->detections)

@@ -121,7 +121,8 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   diagnostics_.setHardwareID(robot_id_);
   diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);
   timer_ = nh_.createTimer(ros::Duration(period), [this](const ros::TimerEvent&) { planOnce(); });
-  diagnostics_timer_.start(nh_, diagnostics_);
+  diagnostics_.input("beliefs");
+  diagnostics_.start(nh_);
   ROS_INFO("%s: robot %s, policy %s, %zu pickers (beliefs from %s), %zu other robots, planning every %.1f s",
            name.c_str(), robot_id_.c_str(), nbs::toString(config.policy), pickers_.size(),
            beliefs_->topic().c_str(), peer_subs_.size(), period);
@@ -150,6 +151,7 @@ void NbsPlannerNode::applyPickerList(const std::vector<std::string>& ids) {
 }
 
 void NbsPlannerNode::beliefCallback(const picker_localisation::PickerBelief& msg) {
+  diagnostics_.tick("beliefs");
   const auto found = by_id_.find(msg.picker_id);
   if (found == by_id_.end()) {
     ++beliefs_of_others_;

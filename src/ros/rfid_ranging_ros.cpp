@@ -34,10 +34,11 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
   const std::vector<std::string> topics = stringListParam(pnh, "rfid_topics", {"rfid"});
   for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
-  updater_.setHardwareID("rfid_ranging");
+  diagnostics_.setHardwareID("rfid_ranging");
   silence_.configure(pnh, "RFID reads");
-  updater_.add("RFID ranging", this, &RfidRangingNode::diagnose);
-  diag_timer_.start(nh, updater_);
+  diagnostics_.add("RFID ranging", this, &RfidRangingNode::diagnose);
+  diagnostics_.input("rfid reads");
+  diagnostics_.start(nh);
   registry_sub_ = followPickerList(nh, pnh, "rfid_ranging", [this](const core::PickerRegistry& r) {
     model_->setRegistry(r);
     ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());
@@ -46,6 +47,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
 }
 
 void RfidRangingNode::onReading(const picker_localisation::RfidReading::ConstPtr& msg) {
+  diagnostics_.tick("rfid reads");
   silence_.heard();
   if (stamp_guard_.clockJumpedBack()) {
     ROS_WARN("rfid_ranging: the clock jumped back: read histories reset");

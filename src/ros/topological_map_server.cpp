@@ -32,10 +32,9 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
              map_file.c_str(), map.numNodes(), map.numDirectedEdges(), map.numLanes());
     lanes_ = map.numLanes();
     components_ = map.numComponents();
-    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh, pnh);
-    diagnostics_->setHardwareID(map_file);
-    diagnostics_->add("topological map", this, &TopologicalMapServer::diagnose);
-    diagnostics_timer_.start(nh, *diagnostics_, 1.0, /*wall=*/true);
+    diagnostics_.setHardwareID(map_file);
+    diagnostics_.add("topological map", this, &TopologicalMapServer::diagnose);
+    diagnostics_.start(nh, 1.0, /*wall=*/true);
     ok_ = true;
   } catch (const topology::MapError& e) {
     ROS_FATAL("topological_map_server: %s", e.what());

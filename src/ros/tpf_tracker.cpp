@@ -282,7 +282,8 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   updatePredictionTimer();
   diagnostics_.setHardwareID("tpf_tracker");
   diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
-  diagnostics_timer_.start(nh, diagnostics_);
+  diagnostics_.input("observations");
+  diagnostics_.start(nh);
   ROS_INFO("tpf_tracker: %zu picker(s), map '%s' (%zu nodes), ordering latency %.2f s (%s)", tracks_.size(),
            map_->name().c_str(), map_->numNodes(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "fused on arrival");
@@ -418,6 +419,7 @@ std::vector<TpfTracker::Track*> TpfTracker::route(bool identifying, const std::s
 }
 
 void TpfTracker::observationCallback(const picker_localisation::Observation::ConstPtr& msg) {
+  diagnostics_.tick("observations");
   ++received_;
   checkClockJump();
   const std::vector<Track*> targets = route(msg->identifying, msg->picker_id, msg->candidate_pickers);
@@ -659,13 +661,6 @@ bool TpfTracker::listPickers(picker_localisation::ListPickers::Request&, picker_
 }
 
 void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  // Input rate over the last diagnostics period (wall time: the rate at which this node is fed).
-  const ros::WallTime now = ros::WallTime::now();
-  if (!last_diag_time_.isZero() && now > last_diag_time_)
-    stat.add("observation rate (Hz)",
-             static_cast<double>(received_ - last_diag_received_) / (now - last_diag_time_).toSec());
-  last_diag_time_ = now;
-  last_diag_received_ = received_;
   stat.add("pickers", tracks_.size());
   std::size_t advertised = 0;
   for (const auto& kv : tracks_)

@@ -61,10 +61,12 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   for (const std::string& t : bearing_topics)
     subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
   flush_timer_ = nh.createWallTimer(ros::WallDuration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
-  updater_.setHardwareID("uwb_ranging");
+  diagnostics_.setHardwareID("uwb_ranging");
   silence_.configure(pnh, "UWB ranges");
-  updater_.add("UWB ranging", this, &UwbRangingNode::diagnose);
-  diag_timer_.start(nh, updater_);
+  diagnostics_.add("UWB ranging", this, &UwbRangingNode::diagnose);
+  diagnostics_.input("uwb ranges");
+  diagnostics_.input("bearings");
+  diagnostics_.start(nh);
   registry_sub_ = followPickerList(nh, pnh, "uwb_ranging", [this](const core::PickerRegistry& r) {
     uwb_->setRegistry(r);
     ROS_INFO("uwb_ranging: picker list from the tracker: %zu picker(s)", r.size());
@@ -92,6 +94,7 @@ std::optional<Eigen::Isometry2d> UwbRangingNode::mount(const std::string& base, 
 }
 
 void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg) {
+  diagnostics_.tick("uwb ranges");
   silence_.heard();
   if (stamp_guard_.clockJumpedBack()) {
     ROS_WARN("uwb_ranging: the clock jumped back: tag filters reset");
@@ -140,6 +143,7 @@ void UwbRangingNode::onRange(const picker_localisation::UwbRange::ConstPtr& msg)
 }
 
 void UwbRangingNode::onBearings(const picker_localisation::BearingDetectionArray::ConstPtr& msg) {
+  diagnostics_.tick("bearings");
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;  // counted by the guard
   std::string error;
   std::optional<Eigen::Isometry2d> cam = mount(baseFrame(msg->robot_id), msg->header.frame_id, msg->header.stamp, &error);

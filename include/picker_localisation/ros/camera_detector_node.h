@@ -3,7 +3,7 @@
 // `detections` + annotated `debug_image`. Runs at most ~max_rate Hz; frames older than ~max_age are dropped.
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
@@ -38,8 +38,7 @@ class CameraDetectorNode {
   ros::Publisher detections_pub_, debug_pub_;
   sensor_msgs::CameraInfo::ConstPtr info_;
   ros::Time last_processed_;
-  diagnostic_updater::Updater diagnostics_;
-  DiagnosticsTimer diagnostics_timer_;  // publishes diagnostics_ at 1 Hz (ROS time)
+  NodeDiagnostics diagnostics_;  // published at 1 Hz (ROS time)
   std::size_t received_ = 0, processed_ = 0, dropped_stale_ = 0, dropped_rate_ = 0, dropped_no_info_ = 0,
               bad_images_ = 0, boxes_ = 0;
   StampGuard stamp_guard_;  // future stamps, clock jumping back

@@ -13,7 +13,7 @@
 // stamped <= t_k. So the errors depend on the messages' stamps, never on when a timer fired.
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 
@@ -77,8 +77,7 @@ class Evaluator {
   void sampleAt(double t);
   std::string output_csv_;
   ros::Timer timer_;
-  diagnostic_updater::Updater diagnostics_;
-  DiagnosticsTimer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
 };
 
 }  // namespace ros_adapter

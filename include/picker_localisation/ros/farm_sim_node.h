@@ -3,7 +3,7 @@
 // ground truth; /<robot>/goal retargets a robot. Parameters and topics: docs/readme/sim.md, config/sim.yaml.
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <picker_localisation/GoalNode.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -63,7 +63,7 @@ class FarmSimNode {
   tf2_ros::TransformBroadcaster tf_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   bool publish_sensor_frames_ = true;
-  std::unique_ptr<diagnostic_updater::Updater> diag_;
+  NodeDiagnostics diagnostics_;
   std::size_t n_fix_ = 0, n_scan_ = 0, n_rfid_ = 0, n_uwb_ = 0, n_camera_ = 0, goals_accepted_ = 0,
               goals_rejected_ = 0;
   ros::WallTime wall_start_;

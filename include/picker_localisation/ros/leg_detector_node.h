@@ -3,7 +3,7 @@
 // person on /observations. Fusion with a camera when ~detections_topic is set (seed 003 Algorithm 4).
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/BearingDetectionArray.h>
 #include <ros/ros.h>
@@ -65,8 +65,7 @@ class LegDetectorNode {
   ros::Publisher people_pub_, obs_pub_, people_markers_pub_;
   picker_localisation::BearingDetectionArray::ConstPtr last_detections_;
   sensor_msgs::CameraInfo::ConstPtr camera_info_;
-  diagnostic_updater::Updater diagnostics_;
-  DiagnosticsTimer diagnostics_timer_;  // publishes diagnostics_ at 1 Hz (ROS time)
+  NodeDiagnostics diagnostics_;  // published at 1 Hz (ROS time)
   std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
               camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0, bad_detections_ = 0,
               bad_scans_ = 0;

@@ -10,7 +10,7 @@
 // read. Parameters: config/nbs.yaml.
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 #include <tf2_ros/buffer.h>
@@ -96,8 +96,7 @@ class NbsPlannerNode {
   ros::Timer timer_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
-  diagnostic_updater::Updater diagnostics_;
-  DiagnosticsTimer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
 
   std::optional<nbs::PlanResult> last_plan_;
   ros::Time last_plan_stamp_;

@@ -3,7 +3,7 @@
 // config/gnss_ingest.yaml, config/rfid_ranging.yaml, config/uwb_ranging.yaml.
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -159,8 +159,7 @@ class GnssIngestNode {
   core::StampOrderedBuffer<Input> ordering_;
   double ordering_latency_ = 0.0;
   ros::Timer ordering_timer_;
-  diagnostic_updater::Updater updater_;
-  DiagnosticsTimer diag_timer_;
+  NodeDiagnostics diagnostics_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
   std::size_t picker_poses_ = 0, bad_poses_ = 0;
   std::string people_pose_sensor_ = "people", pose_sensor_ = "pose", pose_topic_format_;
@@ -191,8 +190,7 @@ class RfidRangingNode {
   std::vector<ros::Subscriber> subs_;
   ros::Subscriber registry_sub_;
   ros::Publisher pub_;
-  diagnostic_updater::Updater updater_;
-  DiagnosticsTimer diag_timer_;
+  NodeDiagnostics diagnostics_;
   std::size_t tf_failures_ = 0, published_ = 0;
   StampGuard stamp_guard_;
   SilenceWatch silence_;
@@ -228,8 +226,7 @@ class UwbRangingNode {
   ros::Subscriber registry_sub_;
   ros::Publisher pub_;
   ros::WallTimer flush_timer_;
-  diagnostic_updater::Updater updater_;
-  DiagnosticsTimer diag_timer_;
+  NodeDiagnostics diagnostics_;
   std::size_t tf_failures_ = 0, published_ = 0, bearing_sets_ = 0;
   StampGuard stamp_guard_;
   SilenceWatch silence_;

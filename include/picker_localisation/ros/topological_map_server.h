@@ -1,7 +1,7 @@
 // ROS adapter: load a topological map and publish it latched with its rviz markers.
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/GetTopologicalMap.h>
 #include <ros/ros.h>
@@ -27,8 +27,7 @@ class TopologicalMapServer {
   picker_localisation::TopologicalMap msg_;
   ros::Publisher map_pub_, marker_pub_;
   ros::ServiceServer service_;
-  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
-  DiagnosticsTimer diagnostics_timer_;  // wall time: reports even while a simulated clock is paused
+  NodeDiagnostics diagnostics_;  // wall time: reports even while a simulated clock is paused
   std::size_t lanes_ = 0, components_ = 0, requests_ = 0;
 };
 

@@ -39,8 +39,7 @@
 // picker's id), frame_id (map), max_future_stamp (10 s).
 #pragma once
 
-#include "picker_localisation/ros/diagnostics_timer.h"
-#include <diagnostic_updater/diagnostic_updater.h>
+#include "picker_localisation/ros/node_diagnostics.h"
 #include <ros/ros.h>
 #include <std_msgs/String.h>
 
@@ -156,15 +155,12 @@ class TpfTracker {
   OnDemandTopics on_demand_;
   ros::ServiceServer add_srv_, remove_srv_, list_srv_;
   ros::Timer prediction_timer_, ordering_timer_;
-  DiagnosticsTimer diagnostics_timer_;
   double timer_period_ = 0.0;
   core::StampOrderedBuffer<Pending> ordering_;
   double ordering_latency_ = 0.0;
-  diagnostic_updater::Updater diagnostics_;
+  NodeDiagnostics diagnostics_;
   std::uint64_t received_ = 0, unrouted_ = 0, added_ = 0, removed_ = 0, refused_requests_ = 0;
   StampGuard stamp_guard_;
-  std::uint64_t last_diag_received_ = 0;
-  ros::WallTime last_diag_time_;
 };
 
 }  // namespace ros_adapter
