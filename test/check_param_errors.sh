@@ -2,7 +2,7 @@
 # Issue "One options schema": a node given an out-of-range parameter stops with one FATAL line naming the key,
 # the value and the allowed range (exit status 1); a node given an unknown parameter (a typo) warns once, naming
 # the closest known key, and keeps running. Checked for leg_detector, gnss_ingest and tpf_tracker against a real
-# rosmaster. Usage: check_param_errors.sh PACKAGE_DIR (run through the devel space's env.sh).
+# rosmaster (and the FATAL line of uwb_ranging, rfid_ranging and camera_detector). Usage: check_param_errors.sh PACKAGE_DIR (run through the devel space's env.sh).
 set -u
 pkg="$1"
 map="$pkg/config/maps/riseholme.tmap2"
@@ -58,4 +58,8 @@ expect_warning gnss_ingest association_min_probabilty \
   "unknown key 'association_min_probabilty' (did you mean 'association_min_probability'?)" "${common_gnss[@]}"
 expect_fatal tpf_tracker num_particles 0 "num_particles = 0: must be > 0" "${common_tpf[@]}"
 expect_warning tpf_tracker num_particle "unknown key 'num_particle' (did you mean 'num_particles'?)" "${common_tpf[@]}"
+# The other front-ends: the FATAL line (their unknown-key warnings come from the same core::unknownKeys).
+expect_fatal uwb_ranging p_min_uwb 2 "p_min_uwb = 2: must be in (0, 1\]" "${common_tpf[@]}"
+expect_fatal rfid_ranging d50 -1 "d50 = -1: must be finite and > 0" "${common_tpf[@]}"
+expect_fatal camera_detector resize 0 "resize = 0: must be in (0, 4\]"
 exit $fail

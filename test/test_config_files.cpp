@@ -9,12 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
-#include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
+#include "picker_localisation/sensors_ranging/uwb_ranging.h"
 #include "picker_localisation/sensors_vision/leg_pipeline.h"
+#include "picker_localisation/sensors_vision/person_box_detector.h"
 #include "picker_localisation/sim/farm_simulator.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/tpf/tpf_params.h"
@@ -46,11 +48,17 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_NO_THROW(sensors::RfidModelOptions::fromYamlFile(use("rfid_ranging.yaml"), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
+  EXPECT_NO_THROW(sensors::UwbRangingOptions::fromYamlFile(use("uwb_ranging.yaml"), &unknown));
+  EXPECT_TRUE(unknown.empty()) << joined(unknown);
+  unknown.clear();
   // leg_detector loads vision.yaml; the simulator's launch files and the runner put vision_sim.yaml over it.
   EXPECT_NO_THROW(sensors::LegPipelineOptions::fromYamlFiles({use("vision.yaml")}, &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
   EXPECT_NO_THROW(sensors::LegPipelineOptions::fromYamlFiles({config("vision.yaml"), use("vision_sim.yaml")}, &unknown));
+  EXPECT_TRUE(unknown.empty()) << joined(unknown);
+  unknown.clear();
+  EXPECT_NO_THROW(sensors::CameraDetectorOptions::fromYamlFile(config("vision.yaml"), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
   EXPECT_NO_THROW(nbs::PlannerConfig::fromYamlFile(use("nbs.yaml"), &unknown));
@@ -60,8 +68,6 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_NO_THROW(core::GeodeticDatum::load(use("datum.yaml")));
   EXPECT_NO_THROW(core::PickerRegistry::load(use("pickers.yaml")));
   EXPECT_NO_THROW(topology::loadMap(config("maps/riseholme.tmap2")));
-  // Read by uwb_ranging key by key (no options schema yet): listed so that a new file is not missed silently.
-  covered.insert("uwb_ranging.yaml");
   // Every YAML file in config/ is covered above.
   for (const auto& entry : std::filesystem::directory_iterator(std::string(PL_PACKAGE_DIR) + "/config")) {
     if (entry.path().extension() != ".yaml") continue;

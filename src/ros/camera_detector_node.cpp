@@ -6,36 +6,24 @@
 
 #include <cmath>
 
+#include "picker_localisation/ros/param_yaml.h"
+
 namespace picker_localisation {
 namespace ros_adapter {
 
 CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh) {
-  pnh_.param("robot_id", robot_id_, robot_id_);
-  pnh_.param("bearing_frame", bearing_frame_, bearing_frame_);
-  pnh_.param("max_rate", max_rate_, max_rate_);
-  pnh_.param("max_age", max_age_, max_age_);
-  stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
-  pnh_.param("horizontal_fov", horizontal_fov_, horizontal_fov_);
-  std::string onnx;
-  pnh_.param("onnx_model", onnx, onnx);
+  // One options schema (config/vision.yaml camera_detector section, same keys as the private parameters).
+  sensors::CameraDetectorOptions o;
+  if (!loadOptions(pnh_, o)) return;
+  robot_id_ = o.robot_id;
+  bearing_frame_ = o.bearing_frame;
+  max_rate_ = o.max_rate;
+  max_age_ = o.max_age;
+  stamp_guard_ = StampGuard(o.max_future_stamp);
+  horizontal_fov_ = o.horizontal_fov;
   try {
-    if (onnx.empty()) {
-      sensors::HogOptions o;
-      pnh_.param("resize", o.resize, o.resize);
-      pnh_.param("hit_threshold", o.hit_threshold, o.hit_threshold);
-      pnh_.param("min_confidence", o.min_confidence, o.min_confidence);
-      pnh_.param("scale", o.scale, o.scale);
-      detector_ = std::make_unique<sensors::HogPersonDetector>(o);
-    } else {
-      sensors::OnnxOptions o;
-      o.model_path = onnx;
-      pnh_.param("onnx_input_width", o.input_width, o.input_width);
-      pnh_.param("onnx_input_height", o.input_height, o.input_height);
-      pnh_.param("onnx_person_class", o.person_class, o.person_class);
-      pnh_.param("min_confidence", o.min_confidence, o.min_confidence);
-      detector_ = std::make_unique<sensors::OnnxPersonDetector>(o);
-    }
+    detector_ = o.makeDetector();
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
     return;
@@ -50,7 +38,7 @@ CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.input("images", 5.0);
   diagnostics_.start(nh_);
   ok_ = true;
-  ROS_INFO("%s: %s detector, at most %.1f Hz", ros::this_node::getName().c_str(), onnx.empty() ? "HOG" : "ONNX",
+  ROS_INFO("%s: %s detector, at most %.1f Hz", ros::this_node::getName().c_str(), o.onnx_model.empty() ? "HOG" : "ONNX",
            max_rate_);
 }
 

@@ -3,6 +3,7 @@
 
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/ranging_nodes.h"
 
 namespace picker_localisation {
@@ -12,30 +13,9 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "uwb_ranging");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
+  // One options schema, shared with the offline runner (config/uwb_ranging.yaml keys).
   sensors::UwbRangingOptions o;
-  sensors::RhfOptions& h = o.rhf;
-  pnh.param("grid_size_x", h.size_x, h.size_x);
-  pnh.param("grid_size_y", h.size_y, h.size_y);
-  pnh.param("grid_resolution", h.resolution, h.resolution);
-  pnh.param("max_speed", h.max_speed, h.max_speed);
-  pnh.param("p_threshold", h.p_threshold, h.p_threshold);
-  pnh.param("p_min_uwb", h.p_min_uwb, h.p_min_uwb);
-  pnh.param("p_min_cam", h.p_min_cam, h.p_min_cam);
-  pnh.param("p_min_obs", h.p_min_obs, h.p_min_obs);
-  pnh.param("p_min_inov", h.p_min_inov, h.p_min_inov);
-  pnh.param("default_range_sigma", h.default_range_sigma, h.default_range_sigma);
-  pnh.param("bearing_sigma", h.default_bearing_sigma, h.default_bearing_sigma);
-  pnh.param("output_threshold", h.output_threshold, h.output_threshold);
-  pnh.param("camera_gate", h.camera_gate, h.camera_gate);
-  pnh.param("max_range", o.max_range, o.max_range);
-  pnh.param("batch_window", o.batch_window, o.batch_window);
-  pnh.param("bearing_max_age", o.bearing_max_age, o.bearing_max_age);
-  pnh.param("pdoa_mode", o.pdoa_mode, o.pdoa_mode);
-  pnh.param("pdoa_angle_sigma", o.pdoa_angle_sigma, o.pdoa_angle_sigma);
-  pnh.param("min_sigma", o.min_sigma, o.min_sigma);
-  pnh.param("cutoff_sigmas", o.cutoff_sigmas, o.cutoff_sigmas);
-  pnh.param("reset_after", o.reset_after, o.reset_after);
-  pnh.param("max_output_sigma", o.max_output_sigma, o.max_output_sigma);
+  if (!loadOptions(pnh, o)) return;
   pnh.param<std::string>("map_frame", map_frame_, "map");
   stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
   pnh.param<std::string>("base_frame", base_frame_, "");

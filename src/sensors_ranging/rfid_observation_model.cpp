@@ -63,7 +63,31 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "registry_topic"};
     for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
   }
-  return o;  // value ranges: checked by RfidObservationModel's constructor (one line naming the key)
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  return o;
+}
+
+std::string RfidModelOptions::validate() const {
+  const auto bad = core::badValue;
+  if (read_model != "logistic" && read_model != "disc")
+    return "read_model = " + read_model + ": must be logistic or disc";
+  if (!(attempt_rate >= 0.0) || !std::isfinite(attempt_rate))
+    return bad("attempt_rate", attempt_rate, "finite and >= 0");
+  if (max_failed_attempts < 0) return bad("max_failed_attempts", max_failed_attempts, ">= 0");
+  if (!(p_detect >= 0.0 && p_detect <= 1.0)) return bad("p_detect", p_detect, "in [0, 1]");
+  if (read_model == "disc") {
+    if (!(read_range > 0.0) || !std::isfinite(read_range))
+      return bad("read_range", read_range, "finite and > 0");
+    return "";
+  }
+  if (!(p_max > 0.0 && p_max <= 1.0)) return bad("p_max", p_max, "in (0, 1]");
+  if (!(width > 0.0) || !std::isfinite(width)) return bad("width", width, "finite and > 0");
+  if (!(max_range > 0.0) || !std::isfinite(max_range)) return bad("max_range", max_range, "finite and > 0");
+  if (!(min_relative > 0.0 && min_relative < 1.0)) return bad("min_relative", min_relative, "in (0, 1)");
+  if (!(d50 > 0.0) || !std::isfinite(d50)) return bad("d50", d50, "finite and > 0");
+  if (!std::isfinite(height_difference)) return bad("height_difference", height_difference, "finite");
+  return "";
 }
 
 RfidModelOptions RfidModelOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
@@ -91,30 +115,14 @@ RfidObservationModel::RfidObservationModel(core::PickerRegistry registry,
                                            RfidModelOptions options)
     : registry_(std::move(registry)), map_(std::move(map)), options_(options) {
   if (!map_) throw std::invalid_argument("RfidObservationModel: no map");
-  if (!(options_.attempt_rate >= 0.0) || !std::isfinite(options_.attempt_rate))
-    throw std::invalid_argument("RfidObservationModel: attempt_rate must be finite and >= 0");
-  if (options_.max_failed_attempts < 0)
-    throw std::invalid_argument("RfidObservationModel: max_failed_attempts must be >= 0");
-  options_.p_detect = std::clamp(options_.p_detect, 0.0, 1.0);
+  const std::string problem = options_.validate();
+  if (!problem.empty()) throw std::invalid_argument("RfidObservationModel: " + problem);
   if (options_.read_model == "disc") {
     logistic_ = false;
-    if (!(options_.read_range > 0.0))
-      throw std::invalid_argument("RfidObservationModel: read_range must be > 0");
     region_radius_ = options_.read_range;
     position_variance_ = options_.read_range * options_.read_range / 4.0;  // uniform disc: R^2 / 4 per axis
     return;
   }
-  if (options_.read_model != "logistic")
-    throw std::invalid_argument("RfidObservationModel: read_model must be 'logistic' or 'disc', not '" +
-                                options_.read_model + "'");
-  if (!(options_.p_max > 0.0 && options_.p_max <= 1.0))
-    throw std::invalid_argument("RfidObservationModel: p_max must be in (0, 1]");
-  if (!(options_.width > 0.0)) throw std::invalid_argument("RfidObservationModel: width must be > 0");
-  if (!(options_.max_range > 0.0)) throw std::invalid_argument("RfidObservationModel: max_range must be > 0");
-  if (!(options_.min_relative > 0.0 && options_.min_relative < 1.0))
-    throw std::invalid_argument("RfidObservationModel: min_relative must be in (0, 1)");
-  if (!std::isfinite(options_.d50) || !std::isfinite(options_.height_difference))
-    throw std::invalid_argument("RfidObservationModel: d50 and height_difference must be finite");
   // Cut-off: p_read(d) / p_max >= min_relative  <=>  d <= d50 + width ln(1 / min_relative - 1) (3D distance).
   const double cutoff_3d = std::min(
       options_.max_range, options_.d50 + options_.width * std::log(1.0 / options_.min_relative - 1.0));

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
+
 namespace picker_localisation {
 namespace sensors {
 
@@ -45,13 +48,98 @@ const char* toString(UwbRejection r) {
   return "unknown";
 }
 
+// The RHF's keys in the node's files (seed 004 names), then the ranging keys, then the node's own keys.
+const std::vector<std::string>& UwbRangingOptions::yamlKeys() {
+  static const std::vector<std::string> keys{
+      "grid_size_x", "grid_size_y", "grid_resolution", "max_speed", "p_threshold", "p_min_uwb", "p_min_cam",
+      "p_min_obs", "p_min_inov", "default_range_sigma", "bearing_sigma", "output_threshold", "camera_gate",
+      "max_range", "batch_window", "bearing_max_age", "pdoa_mode", "pdoa_angle_sigma", "min_sigma",
+      "cutoff_sigmas", "reset_after", "max_output_sigma",
+      // uwb_ranging node
+      "map_frame", "base_frame", "observation_topic", "max_future_stamp", "uwb_topics", "bearing_topics",
+      "tf_timeout", "map_timeout", "flush_period", "map_file", "pickers_file", "map_topic", "silent_warn_after",
+      "registry_topic"};
+  return keys;
+}
+
+UwbRangingOptions UwbRangingOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  UwbRangingOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "uwb_ranging";
+  RhfOptions& h = o.rhf;
+  core::readOption(y, c, "grid_size_x", h.size_x);
+  core::readOption(y, c, "grid_size_y", h.size_y);
+  core::readOption(y, c, "grid_resolution", h.resolution);
+  core::readOption(y, c, "max_speed", h.max_speed);
+  core::readOption(y, c, "p_threshold", h.p_threshold);
+  core::readOption(y, c, "p_min_uwb", h.p_min_uwb);
+  core::readOption(y, c, "p_min_cam", h.p_min_cam);
+  core::readOption(y, c, "p_min_obs", h.p_min_obs);
+  core::readOption(y, c, "p_min_inov", h.p_min_inov);
+  core::readOption(y, c, "default_range_sigma", h.default_range_sigma);
+  core::readOption(y, c, "bearing_sigma", h.default_bearing_sigma);
+  core::readOption(y, c, "output_threshold", h.output_threshold);
+  core::readOption(y, c, "camera_gate", h.camera_gate);
+  core::readOption(y, c, "max_range", o.max_range);
+  core::readOption(y, c, "batch_window", o.batch_window);
+  core::readOption(y, c, "bearing_max_age", o.bearing_max_age);
+  core::readOption(y, c, "pdoa_mode", o.pdoa_mode);
+  core::readOption(y, c, "pdoa_angle_sigma", o.pdoa_angle_sigma);
+  core::readOption(y, c, "min_sigma", o.min_sigma);
+  core::readOption(y, c, "cutoff_sigmas", o.cutoff_sigmas);
+  core::readOption(y, c, "reset_after", o.reset_after);
+  core::readOption(y, c, "max_output_sigma", o.max_output_sigma);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  if (unknown)
+    for (auto& m : core::unknownKeys(y, yamlKeys(), c)) unknown->push_back(std::move(m));
+  return o;
+}
+
+UwbRangingOptions UwbRangingOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [&](const YAML::Node& root) { return fromYaml(root, unknown); });
+}
+
+std::string UwbRangingOptions::validate() const {
+  const auto bad = core::badValue;
+  auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
+  auto unit = [](double v) { return v > 0.0 && v <= 1.0; };
+  if (!positive(rhf.resolution)) return bad("grid_resolution", rhf.resolution, "finite and > 0");
+  if (!(rhf.size_x >= rhf.resolution) || !std::isfinite(rhf.size_x))
+    return bad("grid_size_x", rhf.size_x, "finite and >= grid_resolution");
+  if (!(rhf.size_y >= rhf.resolution) || !std::isfinite(rhf.size_y))
+    return bad("grid_size_y", rhf.size_y, "finite and >= grid_resolution");
+  if (!(rhf.max_speed >= 0.0) || !std::isfinite(rhf.max_speed)) return bad("max_speed", rhf.max_speed, "finite and >= 0");
+  if (!(rhf.p_threshold >= 0.0 && rhf.p_threshold < 1.0)) return bad("p_threshold", rhf.p_threshold, "in [0, 1)");
+  if (!unit(rhf.p_min_uwb)) return bad("p_min_uwb", rhf.p_min_uwb, "in (0, 1]");
+  if (!unit(rhf.p_min_cam)) return bad("p_min_cam", rhf.p_min_cam, "in (0, 1]");
+  if (!unit(rhf.p_min_obs)) return bad("p_min_obs", rhf.p_min_obs, "in (0, 1]");
+  if (!unit(rhf.p_min_inov)) return bad("p_min_inov", rhf.p_min_inov, "in (0, 1]");
+  if (!positive(rhf.default_range_sigma)) return bad("default_range_sigma", rhf.default_range_sigma, "finite and > 0");
+  if (!positive(rhf.default_bearing_sigma)) return bad("bearing_sigma", rhf.default_bearing_sigma, "finite and > 0");
+  if (!(rhf.output_threshold >= 0.0 && rhf.output_threshold <= 1.0))
+    return bad("output_threshold", rhf.output_threshold, "in [0, 1]");
+  if (!(rhf.camera_gate >= 0.0 && rhf.camera_gate <= 1.0)) return bad("camera_gate", rhf.camera_gate, "in [0, 1]");
+  if (!positive(max_range)) return bad("max_range", max_range, "finite and > 0");
+  if (!(batch_window >= 0.0) || !std::isfinite(batch_window)) return bad("batch_window", batch_window, "finite and >= 0");
+  if (!(bearing_max_age >= 0.0) || !std::isfinite(bearing_max_age))
+    return bad("bearing_max_age", bearing_max_age, "finite and >= 0");
+  if (pdoa_mode != "ignore" && pdoa_mode != "bearing" && pdoa_mode != "direct")
+    return "pdoa_mode = " + pdoa_mode + ": must be ignore, bearing or direct";
+  if (!positive(pdoa_angle_sigma)) return bad("pdoa_angle_sigma", pdoa_angle_sigma, "finite and > 0");
+  if (!positive(min_sigma)) return bad("min_sigma", min_sigma, "finite and > 0");
+  if (!positive(cutoff_sigmas)) return bad("cutoff_sigmas", cutoff_sigmas, "finite and > 0");
+  if (!positive(reset_after)) return bad("reset_after", reset_after, "finite and > 0");
+  if (!positive(max_output_sigma)) return bad("max_output_sigma", max_output_sigma, "finite and > 0");
+  return "";
+}
+
 UwbRanging::UwbRanging(core::PickerRegistry registry, std::shared_ptr<const topology::TopologicalMap> map,
                        UwbRangingOptions options)
     : registry_(std::move(registry)), map_(std::move(map)), options_(std::move(options)) {
   if (!map_) throw std::invalid_argument("UwbRanging: no map");
-  if (options_.pdoa_mode != "ignore" && options_.pdoa_mode != "bearing" && options_.pdoa_mode != "direct")
-    throw std::invalid_argument("UwbRanging: pdoa_mode must be ignore, bearing or direct");
-  RangeHistogramFilter check(options_.rhf);  // validates the RHF options now rather than at the first range
+  const std::string problem = options_.validate();
+  if (!problem.empty()) throw std::invalid_argument("UwbRanging: " + problem);
 }
 
 const RangeHistogramFilter* UwbRanging::filter(const std::string& tag_id) const {

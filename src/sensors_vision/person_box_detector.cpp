@@ -9,6 +9,9 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "picker_localisation/core/yaml_file.h"
+#include "picker_localisation/core/yaml_keys.h"
+
 namespace picker_localisation {
 namespace sensors {
 
@@ -38,6 +41,67 @@ struct HogPersonDetector::Impl {
   cv::HOGDescriptor hog;
   std::mutex mutex;  // detectMultiScale is const but keep one user at a time for its internal buffers
 };
+
+const std::vector<std::string>& CameraDetectorOptions::yamlKeys() {
+  static const std::vector<std::string> keys{"onnx_model",        "resize",           "hit_threshold",
+                                             "min_confidence",    "scale",            "onnx_input_width",
+                                             "onnx_input_height", "onnx_person_class", "max_rate",
+                                             "max_age",           "max_future_stamp", "horizontal_fov",
+                                             "bearing_frame",     "robot_id"};
+  return keys;
+}
+
+CameraDetectorOptions CameraDetectorOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  CameraDetectorOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "camera_detector";
+  core::readOption(y, c, "onnx_model", o.onnx_model);
+  core::readOption(y, c, "resize", o.hog.resize);
+  core::readOption(y, c, "hit_threshold", o.hog.hit_threshold);
+  core::readOption(y, c, "scale", o.hog.scale);
+  core::readOption(y, c, "min_confidence", o.hog.min_confidence);
+  core::readOption(y, c, "min_confidence", o.onnx.min_confidence);
+  core::readOption(y, c, "onnx_input_width", o.onnx.input_width);
+  core::readOption(y, c, "onnx_input_height", o.onnx.input_height);
+  core::readOption(y, c, "onnx_person_class", o.onnx.person_class);
+  core::readOption(y, c, "max_rate", o.max_rate);
+  core::readOption(y, c, "max_age", o.max_age);
+  core::readOption(y, c, "max_future_stamp", o.max_future_stamp);
+  core::readOption(y, c, "horizontal_fov", o.horizontal_fov);
+  core::readOption(y, c, "bearing_frame", o.bearing_frame);
+  core::readOption(y, c, "robot_id", o.robot_id);
+  o.onnx.model_path = o.onnx_model;
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  if (unknown)
+    for (auto& m : core::unknownKeys(y, yamlKeys(), c)) unknown->push_back(std::move(m));
+  return o;
+}
+
+CameraDetectorOptions CameraDetectorOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {
+  return core::parseYamlFile(path, [&](const YAML::Node& root) { return fromYaml(root["camera_detector"], unknown); });
+}
+
+std::string CameraDetectorOptions::validate() const {
+  const auto bad = core::badValue;
+  if (!(hog.resize > 0.0 && hog.resize <= 4.0)) return bad("resize", hog.resize, "in (0, 4]");
+  if (!(hog.scale > 1.0 && hog.scale <= 2.0)) return bad("scale", hog.scale, "in (1, 2]");
+  if (!std::isfinite(hog.hit_threshold)) return bad("hit_threshold", hog.hit_threshold, "finite");
+  const double confidence = onnx_model.empty() ? hog.min_confidence : onnx.min_confidence;
+  if (!(confidence >= 0.0 && confidence <= 1.0)) return bad("min_confidence", confidence, "in [0, 1]");
+  if (onnx.input_width <= 0) return bad("onnx_input_width", onnx.input_width, "> 0");
+  if (onnx.input_height <= 0) return bad("onnx_input_height", onnx.input_height, "> 0");
+  if (!(max_rate >= 0.0) || !std::isfinite(max_rate)) return bad("max_rate", max_rate, "finite and >= 0 (0: every frame)");
+  if (!(max_age >= 0.0)) return bad("max_age", max_age, ">= 0 (0: any age)");
+  if (!(max_future_stamp >= 0.0)) return bad("max_future_stamp", max_future_stamp, ">= 0");
+  if (!(horizontal_fov >= 0.0 && horizontal_fov < 2.0 * M_PI)) return bad("horizontal_fov", horizontal_fov, "in [0, 2 pi)");
+  return "";
+}
+
+std::unique_ptr<PersonBoxDetector> CameraDetectorOptions::makeDetector() const {
+  if (onnx_model.empty()) return std::make_unique<HogPersonDetector>(hog);
+  return std::make_unique<OnnxPersonDetector>(onnx);
+}
 
 HogPersonDetector::HogPersonDetector(HogOptions options) : options_(options), impl_(std::make_shared<Impl>()) {
   impl_->hog.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector());

@@ -83,6 +83,7 @@ struct RfidModelOptions {
   // The keys of config/rfid_ranging.yaml (node-only keys accepted and ignored), as GnssIngestOptions::fromYaml.
   static RfidModelOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static RfidModelOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  std::string validate() const;  // "" or "<key> = <value>: must be ..." (fromYaml and the model's constructor call it)
 };
 
 struct RfidResult {

@@ -4,6 +4,8 @@
 // tf and feeds this class; the offline experiment runner feeds it directly.
 #pragma once
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -68,6 +70,15 @@ struct UwbRangingOptions {
   // standard deviation <= max_output_sigma (one anchor's ring or two anchors' mirror pair are not) and no
   // support cell lies on the grid edge. Suppressed estimates still update the filter (counted).
   double max_output_sigma = 2.0;  // m
+
+  // The keys of config/uwb_ranging.yaml (RHF keys: grid_size_x, grid_size_y, grid_resolution, max_speed,
+  // p_threshold, p_min_uwb, p_min_cam, p_min_obs, p_min_inov, default_range_sigma, bearing_sigma,
+  // output_threshold, camera_gate; node-only keys accepted and ignored). A bad value throws std::runtime_error
+  // "uwb_ranging: <key> = <value>: must be ..."; an unknown key goes to *unknown with the closest known one.
+  static UwbRangingOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static UwbRangingOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();
+  std::string validate() const;  // "" or "<key> = <value>: must be ..."
 };
 
 struct UwbCounters {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include <memory>
 #include <string>
@@ -71,6 +72,29 @@ class OnnxPersonDetector : public PersonBoxDetector {
   OnnxOptions options_;
   struct Impl;
   std::shared_ptr<Impl> impl_;
+};
+
+// The camera_detector node's options: the `camera_detector:` section of config/vision.yaml, or the node's private
+// parameters (same keys). min_confidence applies to the detector in use (HOG default 0.3, ONNX 0.5).
+struct CameraDetectorOptions {
+  std::string onnx_model;       // "" = OpenCV's HOG people detector, else an SSD-style ONNX file (OnnxOptions)
+  HogOptions hog;               // keys resize, hit_threshold, min_confidence, scale
+  OnnxOptions onnx;             // keys onnx_input_width, onnx_input_height, onnx_person_class, min_confidence
+  double max_rate = 5.0;  // Hz, frames closer than 1 / max_rate to the last processed one are dropped (0: none)
+  double max_age = 0.5;   // s, frames older than this are dropped (0: none)
+  double max_future_stamp = 10.0;  // s, frames stamped further ahead of the clock are dropped
+  double horizontal_fov = 0.0;  // rad, used only when no CameraInfo arrived (0: none)
+  std::string bearing_frame;    // frame_id of the detections ("" = the image's)
+  std::string robot_id;
+
+  // A bad value throws std::runtime_error "camera_detector: <key> = <value>: must be ..."; an unknown key goes to
+  // *unknown with the closest known one. fromYamlFile reads the file's `camera_detector:` section.
+  static CameraDetectorOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static CameraDetectorOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();
+  std::string validate() const;  // "" or "<key> = <value>: must be ..."
+  // The HOG or the ONNX detector these options name (the ONNX constructor checks the model).
+  std::unique_ptr<PersonBoxDetector> makeDetector() const;
 };
 
 // Pinhole intrinsics along the image's horizontal axis (from sensor_msgs/CameraInfo K: fx = K[0], cx = K[2]).
