@@ -1,5 +1,8 @@
 #include "picker_localisation/ros/evaluator.h"
 
+#include "picker_localisation/core/yaml_keys.h"
+#include "picker_localisation/ros/param_yaml.h"
+
 #include <cmath>
 #include <limits>
 #include <iostream>
@@ -12,23 +15,53 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  EvaluatorOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "evaluator";
+  core::readOption(y, c, "pickers_file", o.pickers_file);
+  core::readOption(y, c, "sample_rate", o.sample_rate);
+  core::readOption(y, c, "duration", o.duration);
+  core::readOption(y, c, "output_csv", o.output_csv);
+  core::readOption(y, c, "ordering_latency", o.ordering_latency);
+  core::readOption(y, c, "max_truth_distance", o.max_truth_distance);
+  core::readOption(y, c, "max_future_stamp", o.max_future_stamp);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  if (unknown) {
+    static const std::vector<std::string> known{
+        "pickers_file",       "sample_rate",      "duration", "output_csv",    "ordering_latency",
+        "max_truth_distance", "max_future_stamp", "map_file", "map_topic",     "belief_topic",
+        "registry_topic"};
+    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
+  }
+  return o;
+}
+
+std::string EvaluatorOptions::validate() const {
+  const auto bad = core::badValue;
+  if (!(sample_rate > 0.0) || !std::isfinite(sample_rate)) return bad("sample_rate", sample_rate, "finite and > 0");
+  if (!(duration >= 0.0)) return bad("duration", duration, ">= 0 (0: none)");
+  if (!(ordering_latency >= 0.0)) return bad("ordering_latency", ordering_latency, ">= 0");
+  if (!(max_truth_distance > 0.0)) return bad("max_truth_distance", max_truth_distance, "> 0");
+  if (!(max_future_stamp >= 0.0)) return bad("max_future_stamp", max_future_stamp, ">= 0");
+  return "";
+}
+
 Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string pickers_file;
-  if (!pnh.getParam("pickers_file", pickers_file) && !nh.getParam("pickers_file", pickers_file)) {
+  EvaluatorOptions o;
+  if (!loadOptions(pnh, o)) return;
+  std::string pickers_file = o.pickers_file;
+  if (pickers_file.empty() && !nh.getParam("pickers_file", pickers_file)) {
     ROS_FATAL("evaluator: parameter ~pickers_file (config/pickers.yaml) is required");
     return;
   }
-  double sample_rate = 1.0;
-  pnh.param("sample_rate", sample_rate, sample_rate);
-  pnh.param("duration", duration_, 0.0);
-  pnh.param<std::string>("output_csv", output_csv_, "");
-  pnh.param("ordering_latency", ordering_latency_, ordering_latency_);
-  pnh.param("max_truth_distance", max_truth_distance_, max_truth_distance_);
-  clock_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
-  if (!(sample_rate > 0.0)) {
-    ROS_FATAL("evaluator: ~sample_rate must be > 0 (got %g)", sample_rate);
-    return;
-  }
+  const double sample_rate = o.sample_rate;
+  duration_ = o.duration;
+  output_csv_ = o.output_csv;
+  ordering_latency_ = o.ordering_latency;
+  max_truth_distance_ = o.max_truth_distance;
+  clock_guard_ = StampGuard(o.max_future_stamp);
   core::PickerRegistry registry;
   try {
     registry = core::PickerRegistry::load(pickers_file);

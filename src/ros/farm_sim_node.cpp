@@ -13,7 +13,9 @@
 #include <thread>
 
 #include "picker_localisation/robot/robot_description.h"
+#include "picker_localisation/core/yaml_keys.h"
 #include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/param_yaml.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
@@ -47,12 +49,6 @@ std::string scanTopicFor(const std::string& frame) {
   return frame.compare(0, stem.size(), stem) == 0 ? "scan_" + frame.substr(stem.size()) : "scan_" + frame;
 }
 
-template <typename T>
-void overrideParam(ros::NodeHandle& pnh, const std::string& name, T& value) {
-  T v;
-  if (pnh.getParam(name, v)) value = v;
-}
-
 }  // namespace
 
 sim::RobotSensorLayout sensorLayoutFromUrdfTemplate(const std::string& path) {
@@ -74,59 +70,107 @@ sim::RobotSensorLayout sensorLayoutFromUrdfTemplate(const std::string& path) {
   return layout;
 }
 
+namespace {
+template <typename T>
+void readOptional(const YAML::Node& y, const char* key, std::optional<T>& out) {
+  T v{};
+  if (!y[key]) return;
+  core::readOption(y, "farm_sim", key, v);
+  out = v;
+}
+}  // namespace
+
+FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
+  FarmSimOptions o;
+  if (!y || !y.IsMap()) return o;
+  const std::string c = "farm_sim";
+  core::readOption(y, c, "sim_config", o.sim_config);
+  core::readOption(y, c, "urdf_template", o.urdf_template);
+  core::readOption(y, c, "pickers_file", o.pickers_file);
+  core::readOption(y, c, "datum_file", o.datum_file);
+  core::readOption(y, c, "datum_source", o.datum_source);
+  readOptional(y, "seed", o.seed);
+  readOptional(y, "robots", o.robots);
+  readOptional(y, "robot_speed", o.robot_speed);
+  readOptional(y, "patrol", o.patrol);
+  readOptional(y, "enable_gnss", o.enable_gnss);
+  readOptional(y, "enable_laser", o.enable_laser);
+  readOptional(y, "enable_rfid", o.enable_rfid);
+  readOptional(y, "enable_uwb", o.enable_uwb);
+  readOptional(y, "enable_camera", o.enable_camera);
+  core::readOption(y, c, "rate_factor", o.rate_factor);
+  core::readOption(y, c, "duration", o.duration);
+  core::readOption(y, c, "clock_step", o.clock_step);
+  core::readOption(y, c, "start_time", o.start_time);
+  core::readOption(y, c, "ground_truth_rate", o.ground_truth_rate);
+  core::readOption(y, c, "publish_sensor_frames", o.publish_sensor_frames);
+  core::readOption(y, c, "map_frame", o.map_frame);
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
+  if (unknown) {
+    static const std::vector<std::string> known{
+        "sim_config",   "urdf_template", "pickers_file", "datum_file",   "datum_source",     "seed",
+        "robots",       "robot_speed",   "patrol",       "enable_gnss",  "enable_laser",     "enable_rfid",
+        "enable_uwb",   "enable_camera", "rate_factor",  "duration",     "clock_step",       "start_time",
+        "ground_truth_rate", "publish_sensor_frames", "map_frame", "map_file", "map_topic"};
+    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
+  }
+  return o;
+}
+
+std::string FarmSimOptions::validate() const {
+  const auto bad = core::badValue;
+  if (seed && *seed < 0) return bad("seed", *seed, ">= 0");
+  if (robots && *robots < 0) return bad("robots", *robots, ">= 0");
+  if (robot_speed && !(*robot_speed > 0.0)) return bad("robot_speed", *robot_speed, "> 0");
+  if (!std::isfinite(rate_factor)) return bad("rate_factor", rate_factor, "finite (<= 0: as fast as possible)");
+  if (!(duration >= 0.0)) return bad("duration", duration, ">= 0 (0: forever)");
+  if (!(clock_step > 0.0) || !std::isfinite(clock_step)) return bad("clock_step", clock_step, "finite and > 0");
+  if (!(start_time > 0.0) || !std::isfinite(start_time)) return bad("start_time", start_time, "finite and > 0");
+  if (!(ground_truth_rate > 0.0)) return bad("ground_truth_rate", ground_truth_rate, "> 0");
+  if (datum_source != "auto" && datum_source != "file" && datum_source != "map")
+    return "datum_source = " + datum_source + ": must be auto, file or map";
+  return "";
+}
+
+void FarmSimOptions::applyOverrides(sim::SimConfig& config) const {
+  if (seed) config.seed = static_cast<std::uint64_t>(*seed);
+  if (robots) config.num_robots = static_cast<std::size_t>(*robots);
+  if (robot_speed) config.robot_motion.speed = *robot_speed;
+  if (patrol) config.robot_motion.patrol = sim::parsePatrolPolicy(*patrol);
+  if (enable_gnss) config.enable.gnss = *enable_gnss;
+  if (enable_laser) config.enable.laser = *enable_laser;
+  if (enable_rfid) config.enable.rfid = *enable_rfid;
+  if (enable_uwb) config.enable.uwb = *enable_uwb;
+  if (enable_camera) config.enable.camera = *enable_camera;
+}
+
 FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh) {
-  // Configuration: ~sim_config file (config/sim.yaml), then individual parameter overrides.
+  // One options schema for the node's parameters; the simulator's from ~sim_config, then the overrides.
+  FarmSimOptions o;
+  if (!loadOptions(pnh_, o)) return;
   sim::SimConfig config;
-  std::string sim_config, pickers_file, datum_file, urdf_template;
-  pnh_.param<std::string>("sim_config", sim_config, "");
-  pnh_.param<std::string>("urdf_template", urdf_template, "");
-  pnh_.param<std::string>("pickers_file", pickers_file, "");
-  pnh_.param<std::string>("datum_file", datum_file, "");
-  std::string datum_source;
-  pnh_.param<std::string>("datum_source", datum_source, "auto");
   try {
-    if (!sim_config.empty()) config = sim::loadSimConfig(sim_config);
-    if (!datum_file.empty()) config.datum = core::GeodeticDatum::load(datum_file).config();
-    if (!urdf_template.empty()) config.sensor_layout = sensorLayoutFromUrdfTemplate(urdf_template);
-    if (!pickers_file.empty()) {
-      registry_ = core::PickerRegistry::load(pickers_file);
+    if (!o.sim_config.empty()) config = sim::loadSimConfig(o.sim_config);
+    if (!o.datum_file.empty()) config.datum = core::GeodeticDatum::load(o.datum_file).config();
+    if (!o.urdf_template.empty()) config.sensor_layout = sensorLayoutFromUrdfTemplate(o.urdf_template);
+    if (!o.pickers_file.empty()) {
+      registry_ = core::PickerRegistry::load(o.pickers_file);
       config.pickers = sim::pickerSpecsFromRegistry(registry_);
     }
+    o.applyOverrides(config);
   } catch (const std::exception& e) {
     ROS_FATAL("farm_sim: %s", e.what());
     return;
   }
-  int seed = static_cast<int>(config.seed), robots = static_cast<int>(config.num_robots);
-  overrideParam(pnh_, "seed", seed);
-  overrideParam(pnh_, "robots", robots);
-  config.seed = static_cast<std::uint64_t>(std::max(0, seed));
-  config.num_robots = static_cast<std::size_t>(std::max(0, robots));
-  overrideParam(pnh_, "robot_speed", config.robot_motion.speed);
-  std::string patrol;
-  if (pnh_.getParam("patrol", patrol)) {
-    try {
-      config.robot_motion.patrol = sim::parsePatrolPolicy(patrol);
-    } catch (const std::exception& e) {
-      ROS_FATAL("farm_sim: ~patrol: %s", e.what());
-      return;
-    }
-  }
-  overrideParam(pnh_, "enable_gnss", config.enable.gnss);
-  overrideParam(pnh_, "enable_laser", config.enable.laser);
-  overrideParam(pnh_, "enable_rfid", config.enable.rfid);
-  overrideParam(pnh_, "enable_uwb", config.enable.uwb);
-  overrideParam(pnh_, "enable_camera", config.enable.camera);
-  pnh_.param("rate_factor", rate_factor_, rate_factor_);
-  pnh_.param("duration", duration_, duration_);
-  pnh_.param("clock_step", clock_step_, clock_step_);
-  pnh_.param("start_time", start_time_, start_time_);
-  pnh_.param("ground_truth_rate", truth_rate_, truth_rate_);
-  pnh_.param("publish_sensor_frames", publish_sensor_frames_, publish_sensor_frames_);
-  pnh_.param<std::string>("map_frame", map_frame_, map_frame_);
-  if (!(clock_step_ > 0.0) || !(start_time_ > 0.0) || !(truth_rate_ > 0.0)) {
-    ROS_FATAL("farm_sim: ~clock_step, ~start_time and ~ground_truth_rate must be > 0");
-    return;
-  }
+  rate_factor_ = o.rate_factor;
+  duration_ = o.duration;
+  clock_step_ = o.clock_step;
+  start_time_ = o.start_time;
+  truth_rate_ = o.ground_truth_rate;
+  publish_sensor_frames_ = o.publish_sensor_frames;
+  map_frame_ = o.map_frame;
+  const std::string& datum_source = o.datum_source;
 
   map_ = obtainMap(nh_, pnh_);
   if (!map_) return;

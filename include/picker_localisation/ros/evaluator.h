@@ -35,6 +35,22 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+// The node's private parameters (see above). pickers_file falls back to the global /pickers_file.
+struct EvaluatorOptions {
+  std::string pickers_file;
+  double sample_rate = 1.0;          // Hz of message time
+  double duration = 0.0;             // s after the first ground truth, then the table and exit (0: none)
+  std::string output_csv;            // "" none
+  double ordering_latency = 1.5;     // s
+  double max_truth_distance = 50.0;  // m, a truth farther from every node is not scored
+  double max_future_stamp = 10.0;    // s
+
+  // A bad value throws std::runtime_error "evaluator: <key> = <value>: must be ..."; an unknown key goes to
+  // *unknown with the closest known one.
+  static EvaluatorOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  std::string validate() const;
+};
+
 class Evaluator {
  public:
   Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh);

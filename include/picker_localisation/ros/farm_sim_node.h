@@ -11,6 +11,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,31 @@ namespace ros_adapter {
 // uwb_anchor_*, camera_* (not *_optical) in base_link, projected to the plane (x, y, yaw) + height z. Base
 // footprint size stays at the defaults. Throws std::runtime_error (one line) on a bad file or no lasers.
 sim::RobotSensorLayout sensorLayoutFromUrdfTemplate(const std::string& path);
+
+// The node's private parameters (docs/readme/sim.md). The simulator's own keys come from ~sim_config
+// (config/sim.yaml, sim::loadSimConfig); the overrides below replace them when set.
+struct FarmSimOptions {
+  std::string sim_config, urdf_template, pickers_file, datum_file;
+  std::string datum_source = "auto";  // auto | file | map (as gnss_ingest)
+  std::optional<int> seed, robots;
+  std::optional<double> robot_speed;
+  std::optional<std::string> patrol;
+  std::optional<bool> enable_gnss, enable_laser, enable_rfid, enable_uwb, enable_camera;
+  double rate_factor = 10.0;  // simulated s per wall s (<= 0: as fast as possible)
+  double duration = 0.0;      // simulated s, then the node exits (0: forever)
+  double clock_step = 0.02;   // simulated s per tick
+  double start_time = 100.0;  // ROS time of simulated t = 0, s
+  double ground_truth_rate = 10.0;  // Hz
+  bool publish_sensor_frames = true;
+  std::string map_frame = "map";
+
+  // A bad value throws std::runtime_error "farm_sim: <key> = <value>: must be ..."; an unknown key goes to
+  // *unknown with the closest known one.
+  static FarmSimOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  std::string validate() const;
+  // The overrides applied to a configuration loaded from ~sim_config (throws on a bad ~patrol).
+  void applyOverrides(sim::SimConfig& config) const;
+};
 
 class FarmSimNode {
  public:
