@@ -46,10 +46,10 @@ install(TARGETS picker_localisation_eval picker_localisation_experiment
 install(TARGETS experiment RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # ROS side: the evaluator node.
-add_library(picker_localisation_eval_ros src/ros/evaluator.cpp)
+add_library(picker_localisation_eval_ros src/ros/evaluator_node.cpp)
 target_link_libraries(picker_localisation_eval_ros PUBLIC picker_localisation_ros picker_localisation_eval)
 add_dependencies(picker_localisation_eval_ros ${PROJECT_NAME}_generate_messages_cpp)
-pl_add_node(evaluator src/nodes/evaluator_node.cpp)
+pl_add_node(evaluator src/nodes/evaluator_main.cpp)
 target_link_libraries(evaluator picker_localisation_eval_ros)
 install(TARGETS picker_localisation_eval_ros
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}

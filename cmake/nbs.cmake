@@ -21,7 +21,7 @@ install(TARGETS picker_localisation_nbs_ros
   ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 
-pl_add_node(nbs_planner src/nodes/nbs_planner_node.cpp)
+pl_add_node(nbs_planner src/nodes/nbs_planner_main.cpp)
 target_link_libraries(nbs_planner picker_localisation_nbs_ros)
 
 # Benchmark: one plan with the TPF what-if, the Choquet integral.

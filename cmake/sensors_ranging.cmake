@@ -22,16 +22,16 @@ endif()
 
 # ROS adapters and nodes.
 add_library(picker_localisation_sensors_ranging_ros
-  src/ros/ranging_ros_common.cpp
-  src/ros/gnss_ingest_ros.cpp
-  src/ros/rfid_ranging_ros.cpp
-  src/ros/uwb_ranging_ros.cpp)
+  src/ros/ranging_nodes.cpp
+  src/ros/gnss_ingest_node.cpp
+  src/ros/rfid_ranging_node.cpp
+  src/ros/uwb_ranging_node.cpp)
 target_link_libraries(picker_localisation_sensors_ranging_ros PUBLIC picker_localisation_ros picker_localisation_sensors_ranging)
 add_dependencies(picker_localisation_sensors_ranging_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_sensors_ranging_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
 foreach(node gnss_ingest rfid_ranging uwb_ranging)
-  pl_add_node(${node} src/nodes/${node}_node.cpp)
+  pl_add_node(${node} src/nodes/${node}_main.cpp)
   target_link_libraries(${node} picker_localisation_sensors_ranging_ros)
 endforeach()
 
@@ -45,6 +45,6 @@ set_target_properties(bench_fleet PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CATKIN_D
 install(TARGETS bench_fleet RUNTIME DESTINATION ${CATKIN_PACKAGE_BIN_DESTINATION})
 
 # picker_fleet: gnss_ingest and tpf_tracker in one process (no socket between them).
-pl_add_node(picker_fleet src/nodes/picker_fleet_node.cpp)
+pl_add_node(picker_fleet src/nodes/picker_fleet_main.cpp)
 target_link_libraries(picker_fleet picker_localisation_sensors_ranging_ros picker_localisation_tpf_ros)
 add_dependencies(bench_fleet picker_fleet)

@@ -20,7 +20,7 @@ target_link_libraries(picker_localisation_sim_ros PUBLIC picker_localisation_ros
 add_dependencies(picker_localisation_sim_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_sim_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}
   LIBRARY DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION})
-pl_add_node(farm_sim src/nodes/farm_sim_node.cpp)
+pl_add_node(farm_sim src/nodes/farm_sim_main.cpp)
 target_link_libraries(farm_sim picker_localisation_sim_ros)
 
 # bench_sim: simulated seconds per wall second.

@@ -1,4 +1,4 @@
-#include "picker_localisation/ros/topological_map_server.h"
+#include "picker_localisation/ros/topological_map_server_node.h"
 
 #include "picker_localisation/ros/map_conversions.h"
 #include "picker_localisation/ros/map_source.h"

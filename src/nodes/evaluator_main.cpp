@@ -1,7 +1,7 @@
 // evaluator: live tracking errors against the simulator's ground truth; prints the error table at shutdown.
 #include <ros/ros.h>
 
-#include "picker_localisation/ros/evaluator.h"
+#include "picker_localisation/ros/evaluator_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "evaluator");

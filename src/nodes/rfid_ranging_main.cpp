@@ -1,7 +1,7 @@
 // rfid_ranging: see docs/readme/sensors_ranging.md and config/rfid_ranging.yaml.
 #include <ros/ros.h>
 
-#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/ros/rfid_ranging_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "rfid_ranging");

@@ -4,7 +4,7 @@
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
-#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/ros/uwb_ranging_node.h"
 
 namespace picker_localisation {
 namespace ros_adapter {

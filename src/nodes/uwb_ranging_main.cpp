@@ -1,7 +1,7 @@
 // uwb_ranging: see docs/readme/sensors_ranging.md and config/uwb_ranging.yaml.
 #include <ros/ros.h>
 
-#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/ros/uwb_ranging_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "uwb_ranging");

@@ -1,4 +1,4 @@
-#include "picker_localisation/ros/evaluator.h"
+#include "picker_localisation/ros/evaluator_node.h"
 
 #include "picker_localisation/core/yaml_keys.h"
 #include "picker_localisation/ros/param_yaml.h"

@@ -1,4 +1,4 @@
-#include "picker_localisation/ros/tpf_tracker.h"
+#include "picker_localisation/ros/tpf_tracker_node.h"
 
 #include <picker_localisation/PickerList.h>
 #include <std_msgs/String.h>

@@ -3,8 +3,8 @@
 // ingest's under ~gnss_ingest/ (~gnss_ingest/datum_file, ...). Topics and services as the two nodes'.
 #include <ros/ros.h>
 
-#include "picker_localisation/ros/ranging_nodes.h"
-#include "picker_localisation/ros/tpf_tracker.h"
+#include "picker_localisation/ros/gnss_ingest_node.h"
+#include "picker_localisation/ros/tpf_tracker_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "tpf_tracker");

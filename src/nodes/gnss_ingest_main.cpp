@@ -1,7 +1,7 @@
 // gnss_ingest: see docs/readme/sensors_ranging.md and config/gnss_ingest.yaml.
 #include <ros/ros.h>
 
-#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/ros/gnss_ingest_node.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "gnss_ingest");

@@ -13,7 +13,7 @@
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
-#include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/ros/gnss_ingest_node.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
