@@ -52,13 +52,13 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
   // leg_detector loads vision.yaml; the simulator's launch files and the runner put vision_sim.yaml over it.
-  EXPECT_NO_THROW(sensors::LegPipelineOptions::fromYamlFiles({use("vision.yaml")}, &unknown));
+  EXPECT_NO_THROW(vision::LegPipelineOptions::fromYamlFiles({use("vision.yaml")}, &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
-  EXPECT_NO_THROW(sensors::LegPipelineOptions::fromYamlFiles({config("vision.yaml"), use("vision_sim.yaml")}, &unknown));
+  EXPECT_NO_THROW(vision::LegPipelineOptions::fromYamlFiles({config("vision.yaml"), use("vision_sim.yaml")}, &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
-  EXPECT_NO_THROW(sensors::CameraDetectorOptions::fromYamlFile(config("vision.yaml"), &unknown));
+  EXPECT_NO_THROW(vision::CameraDetectorOptions::fromYamlFile(config("vision.yaml"), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
   EXPECT_NO_THROW(nbs::PlannerConfig::fromYamlFile(use("nbs.yaml"), &unknown));

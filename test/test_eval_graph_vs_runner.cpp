@@ -30,7 +30,7 @@ namespace {
 constexpr double kEuclideanTolerance = 1.0;    // m
 constexpr double kTopologicalTolerance = 2.0;  // nodes
 // LiDAR observations of the graph over the runner's, same simulated span. The leg pipeline is one class in
-// both (sensors::LegPipeline, parity: test_leg_pipeline_parity); a runner that routes or tracks scans
+// both (vision::LegPipeline, parity: test_leg_pipeline_parity); a runner that routes or tracks scans
 // differently changes this count by a factor of 2.5 or more (issue 16: one tracker shared by both lasers).
 constexpr double kLidarRatioMin = 0.6, kLidarRatioMax = 1.6;
 }  // namespace

@@ -196,9 +196,9 @@ TEST(Fuzz, UwbRangingTakesAnyRange) {
 
 TEST(Fuzz, LegPipelineTakesAnyScan) {
   const auto map = riseholme();
-  auto classifier = std::make_shared<sensors::LegClassifier>();
+  auto classifier = std::make_shared<vision::LegClassifier>();
   classifier->load(kPackage + "/config/leg_classifier.yml");
-  sensors::LegPipeline legs(classifier, sensors::LegPipelineOptions{});
+  vision::LegPipeline legs(classifier, vision::LegPipelineOptions{});
   Wild w(4);
   for (int i = 0; i < 400; ++i) {
     sensor_msgs::LaserScan msg;
@@ -214,10 +214,10 @@ TEST(Fuzz, LegPipelineTakesAnyScan) {
     core::LaserScan scan;
     ASSERT_NO_THROW(scan = ros_adapter::toScanData(msg)) << "scan " << i;
     const Eigen::Isometry3d tf = Eigen::Translation3d(20.0, -20.0, 0.3) * Eigen::AngleAxisd(w.uniform(-3, 3), Eigen::Vector3d::UnitZ());
-    std::vector<sensors::TrackedPerson> people;
+    std::vector<vision::TrackedPerson> people;
     ASSERT_NO_THROW(people = legs.processScan(w.chance(0.5) ? "front" : "rear", scan.stamp, scan, tf)) << "scan " << i;
     for (const auto& p : people) {
-      const core::Observation o = sensors::LegPipeline::observation(p, *map, scan.stamp, "robot_1");
+      const core::Observation o = vision::LegPipeline::observation(p, *map, scan.stamp, "robot_1");
       expectValid(o, *map, "person of scan " + std::to_string(i));
     }
   }
@@ -226,7 +226,7 @@ TEST(Fuzz, LegPipelineTakesAnyScan) {
 TEST(Fuzz, PointCloudCheckGuardsTheConversion) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // as leg_detector does
   Wild w(5);
-  sensors::Cloud3dPersonDetector detector;
+  vision::Cloud3dPersonDetector detector;
   std::size_t checked_ok = 0;
   for (int i = 0; i < kIterations; ++i) {
     sensor_msgs::PointCloud2 c;

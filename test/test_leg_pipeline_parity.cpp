@@ -1,4 +1,4 @@
-// rostest: the leg_detector node and the offline runner's pipeline (sensors::LegPipeline built as
+// rostest: the leg_detector node and the offline runner's pipeline (vision::LegPipeline built as
 // eval::runOnce builds it) turn identical scans into identical Observations. Real labelled scans (leg_tracker
 // positive_4) are published on two laser topics in two frames, interleaved as two corner lasers would be, so
 // a runner that shared one tracker between the lasers (the bug of issue 16) produces other observations.
@@ -75,10 +75,10 @@ TEST(LegPipelineParity, NodeEqualsRunnerPipeline) {
   ASSERT_GE(scans.size(), 60u);
 
   // The runner's pipeline, built exactly as eval::runOnce builds it.
-  auto classifier = std::make_shared<pl::sensors::LegClassifier>();
+  auto classifier = std::make_shared<pl::vision::LegClassifier>();
   classifier->load(std::string(PL_PACKAGE_DIR) + "/config/leg_classifier.yml");
-  pl::sensors::LegPipeline runner(
-      classifier, pl::sensors::LegPipelineOptions::fromYamlFiles(pl::eval::visionConfigFiles("")));
+  pl::vision::LegPipeline runner(
+      classifier, pl::vision::LegPipelineOptions::fromYamlFiles(pl::eval::visionConfigFiles("")));
   const auto map = pl::topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2");
 
   // Scan k goes to laser k % 2 (both lasers see the same real scan content, as two lasers of one robot would
@@ -92,7 +92,7 @@ TEST(LegPipelineParity, NodeEqualsRunnerPipeline) {
     s.header.frame_id = l.frame;
     for (const auto& p :
          runner.processScan(l.frame, s.header.stamp.toSec(), pl::ros_adapter::toScanData(s), poseOf(l)))
-      expected.push_back(pl::sensors::LegPipeline::observation(p, map, s.header.stamp.toSec(), "robot_1"));
+      expected.push_back(pl::vision::LegPipeline::observation(p, map, s.header.stamp.toSec(), "robot_1"));
     pubs[k % 2].publish(s);
     waitFor([] { return false; }, 0.05);
   }
@@ -118,8 +118,8 @@ TEST(LegPipelineParity, NodeEqualsRunnerPipeline) {
   }
 
   // The bug this guards against: one tracker shared by both lasers confirms other people.
-  pl::sensors::LegPipeline shared(
-      classifier, pl::sensors::LegPipelineOptions::fromYamlFiles(pl::eval::visionConfigFiles("")));
+  pl::vision::LegPipeline shared(
+      classifier, pl::vision::LegPipelineOptions::fromYamlFiles(pl::eval::visionConfigFiles("")));
   std::size_t shared_count = 0;
   for (std::size_t k = 0; k < 60; ++k) {
     sensor_msgs::LaserScan s = scans[k / 2];

@@ -15,7 +15,7 @@
 #include "picker_localisation/sensors_vision/person_box_detector.h"
 
 using namespace picker_localisation;
-using namespace picker_localisation::sensors;
+using namespace picker_localisation::vision;
 
 namespace {
 
@@ -262,7 +262,7 @@ TEST(Cloud3dPersonDetector, PersonSizedClusterAboveGroundOnly) {
 
 // The leg pipeline's options schema (shared by the leg_detector node and the offline runner).
 TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
-  using picker_localisation::sensors::LegPipelineOptions;
+  using picker_localisation::vision::LegPipelineOptions;
   std::vector<std::string> unknown;
   const LegPipelineOptions o = LegPipelineOptions::fromYaml(
       YAML::Load("{leg_threshold: 0.3, tentative_misses: 2, position_sigma: 0.2, scan_topics: [a], "
@@ -289,7 +289,7 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
 
 // Images smaller than the HOG window (64 x 128) or of another type crashed OpenCV 4.6 (issue 17): no boxes now.
 TEST(HogPersonDetector, TinyAndOddImagesGiveNoBoxesAndNoCrash) {
-  picker_localisation::sensors::HogPersonDetector hog;
+  picker_localisation::vision::HogPersonDetector hog;
   for (const cv::Size s : {cv::Size(1, 1), cv::Size(10, 10), cv::Size(128, 64), cv::Size(640, 2), cv::Size(63, 127),
                            cv::Size(2, 640)})
     EXPECT_TRUE(hog.detect(cv::Mat(s, CV_8UC3, cv::Scalar::all(128))).empty()) << s;

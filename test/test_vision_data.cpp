@@ -15,7 +15,7 @@
 #include "picker_localisation/sensors_vision/person_box_detector.h"
 
 using namespace picker_localisation;
-using namespace picker_localisation::sensors;
+using namespace picker_localisation::vision;
 
 namespace {
 

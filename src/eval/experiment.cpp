@@ -313,12 +313,12 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
       registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
 #ifdef PL_HAVE_VISION
   // The leg_detector node's pipeline, from the same files and keys (one per robot: per-laser trackers).
-  std::unique_ptr<sensors::LegPipeline> legs;
+  std::unique_ptr<vision::LegPipeline> legs;
   if (spec.lidar) {
-    auto classifier = std::make_shared<sensors::LegClassifier>();
+    auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(legModelPath(config));
-    legs = std::make_unique<sensors::LegPipeline>(
-        classifier, sensors::LegPipelineOptions::fromYamlFiles(visionConfigFiles(config.vision_config)));
+    legs = std::make_unique<vision::LegPipeline>(
+        classifier, vision::LegPipelineOptions::fromYamlFiles(visionConfigFiles(config.vision_config)));
   }
 #endif
 
@@ -450,7 +450,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         const Eigen::Isometry3d fixed_from_sensor =
             Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
             Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
-        const std::vector<sensors::TrackedPerson> tracked =
+        const std::vector<vision::TrackedPerson> tracked =
             legs->processScan(s.frame_id, s.stamp, s, fixed_from_sensor);
         result.lidar_detections += tracked.size();
         // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's
@@ -460,7 +460,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         std::vector<Eigen::Vector2d> people;
         for (const auto& t : tracked) {
           const sensors::AssociationResult a =
-              sensors::associatePerson(sensors::LegPipeline::observation(t, *map, s.stamp, s.robot_id),
+              sensors::associatePerson(vision::LegPipeline::observation(t, *map, s.stamp, s.robot_id),
                                        ingests, beliefs, *map, gnss_options.association, &identity_evidence);
           if (a.picker >= 0) {
             ++result.identified_detections;

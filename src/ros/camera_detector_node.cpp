@@ -14,7 +14,7 @@ namespace ros_adapter {
 CameraDetectorNode::CameraDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), diagnostics_(nh, pnh) {
   // One options schema (config/vision.yaml camera_detector section, same keys as the private parameters).
-  sensors::CameraDetectorOptions o;
+  vision::CameraDetectorOptions o;
   if (!loadOptions(pnh_, o)) return;
   robot_id_ = o.robot_id;
   bearing_frame_ = o.bearing_frame;
@@ -67,7 +67,7 @@ void CameraDetectorNode::imageCallback(const sensor_msgs::Image::ConstPtr& msg) 
     ++dropped_rate_;
     return;
   }
-  sensors::CameraIntrinsics k;
+  vision::CameraIntrinsics k;
   if (info_ && info_->K[0] > 0.0) {
     k = {info_->K[0], info_->K[2], static_cast<int>(info_->width)};
   } else if (horizontal_fov_ > 0.0 && msg->width > 0) {
@@ -104,7 +104,7 @@ void CameraDetectorNode::imageCallback(const sensor_msgs::Image::ConstPtr& msg) 
     d.box.y_offset = static_cast<uint32_t>(b.box.y);
     d.box.width = static_cast<uint32_t>(b.box.width);
     d.box.height = static_cast<uint32_t>(b.box.height);
-    d.bearing = sensors::bearingFromBox(b.box, k);
+    d.bearing = vision::bearingFromBox(b.box, k);
     d.confidence = b.confidence;
     out.detections.push_back(d);
   }

@@ -51,15 +51,15 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
 
   // The pipeline's options: every private parameter through the schema the offline runner uses too.
-  sensors::LegPipelineOptions options;
+  vision::LegPipelineOptions options;
   if (!loadOptions(pnh_, options)) return;
   const std::string default_model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
   std::string model = pnh_.param("model_file", default_model);
   if (model.empty()) model = default_model;  // config/vision.yaml documents "" as the shipped model
   try {
-    auto classifier = std::make_shared<sensors::LegClassifier>();
+    auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(model);
-    pipeline_ = std::make_unique<sensors::LegPipeline>(classifier, options);
+    pipeline_ = std::make_unique<vision::LegPipeline>(classifier, options);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", ros::this_node::getName().c_str(), e.what());
     return;
@@ -188,7 +188,7 @@ void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& ms
   // gate stays relative to the sensor) before the ground removal, then translate the people.
   const Eigen::Matrix3f rotation = tf.linear().cast<float>();
   for (auto& p : cloud.points) p.getVector3fMap() = rotation * p.getVector3fMap();
-  std::vector<sensors::PersonCandidate> people;
+  std::vector<vision::PersonCandidate> people;
   for (const auto& p : cloud_detector_.detect(cloud))
     people.push_back({(p.centroid + tf.translation()).head<2>(), p.confidence, "lidar3d", true});
   publishPeople(msg->header.frame_id, msg->header.stamp, std::move(people));
@@ -211,22 +211,22 @@ void LegDetectorNode::detectionsCallback(const picker_localisation::BearingDetec
 void LegDetectorNode::cameraInfoCallback(const sensor_msgs::CameraInfo::ConstPtr& msg) { camera_info_ = msg; }
 
 void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::Time& stamp,
-                                    const std::vector<sensors::PersonCandidate>& people) {
+                                    const std::vector<vision::PersonCandidate>& people) {
   // The newest camera frame within fusion_max_age, each used once (Algorithm 4 cones).
-  std::optional<sensors::CameraCones> camera;
+  std::optional<vision::CameraCones> camera;
   if (last_detections_ && std::abs(secondsBetween(stamp, last_detections_->header.stamp)) <= fusion_max_age_) {
     Eigen::Isometry3d cam;
     if (lookup(last_detections_->header.frame_id, fixed_frame_, last_detections_->header.stamp, cam)) {
       camera.emplace();
       camera->camera_from_fixed = cam;
       for (const auto& d : last_detections_->detections) {
-        sensors::BearingCone cone{d.bearing, pipeline_->options().cone_half_width, d.confidence};
+        vision::BearingCone cone{d.bearing, pipeline_->options().cone_half_width, d.confidence};
         if (camera_info_ && camera_info_->K[0] > 0.0 && d.box.width > 0) {
           // Sec. 3.4.2: the box's min and max x columns bound the cone.
-          const sensors::CameraIntrinsics k{camera_info_->K[0], camera_info_->K[2],
+          const vision::CameraIntrinsics k{camera_info_->K[0], camera_info_->K[2],
                                             static_cast<int>(camera_info_->width)};
-          const double left = sensors::bearingFromColumn(d.box.x_offset, k);
-          const double right = sensors::bearingFromColumn(d.box.x_offset + d.box.width, k);
+          const double left = vision::bearingFromColumn(d.box.x_offset, k);
+          const double right = vision::bearingFromColumn(d.box.x_offset + d.box.width, k);
           cone.half_width = 0.5 * std::abs(left - right);
         }
         camera->cones.push_back(cone);
@@ -234,7 +234,7 @@ void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::
       last_detections_.reset();
     }
   }
-  const std::vector<sensors::TrackedPerson> tracked =
+  const std::vector<vision::TrackedPerson> tracked =
       pipeline_->track(source_frame, stamp.toSec(), people, camera ? &*camera : nullptr);
 
   picker_localisation::PersonDetectionArray out;
@@ -253,7 +253,7 @@ void LegDetectorNode::publishPeople(const std::string& source_frame, const ros::
     fused_ += t.camera_confirmed ? 1 : 0;
     out.detections.push_back(d);
     if (map_) {
-      obs_pub_.publish(toMsg(sensors::LegPipeline::observation(t, *map_, stamp.toSec(), robot_id_), *map_, fixed_frame_));
+      obs_pub_.publish(toMsg(vision::LegPipeline::observation(t, *map_, stamp.toSec(), robot_id_), *map_, fixed_frame_));
       ++observations_;
     }
   }

@@ -43,7 +43,7 @@ std::vector<BagScan> readBagScans(const std::string& bag_path, const std::vector
   return out;
 }
 
-std::vector<sensors::LabelledScan> readLabelledLegBag(const std::string& bag_path) {
+std::vector<vision::LabelledScan> readLabelledLegBag(const std::string& bag_path) {
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
   std::vector<core::LaserScan> scans;
   std::vector<std::vector<Eigen::Vector2d>> labels;
@@ -60,7 +60,7 @@ std::vector<sensors::LabelledScan> readLabelledLegBag(const std::string& bag_pat
   if (scans.size() != labels.size())
     throw std::runtime_error(bag_path + ": " + std::to_string(scans.size()) + " scans but " +
                              std::to_string(labels.size()) + " label arrays");
-  std::vector<sensors::LabelledScan> out(scans.size());
+  std::vector<vision::LabelledScan> out(scans.size());
   for (std::size_t i = 0; i < scans.size(); ++i) out[i] = {std::move(scans[i]), std::move(labels[i])};
   return out;
 }

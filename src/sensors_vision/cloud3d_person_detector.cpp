@@ -11,7 +11,7 @@
 #include <cmath>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 Cloud3dPersonDetector::Cloud3dPersonDetector(Cloud3dPersonOptions options) : options_(options) {}
 
@@ -97,5 +97,5 @@ std::vector<Cloud3dPerson> Cloud3dPersonDetector::detect(const pcl::PointCloud<p
   return out;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

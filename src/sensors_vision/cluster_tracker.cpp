@@ -5,7 +5,7 @@
 #include "picker_localisation/sensors_vision/munkres.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 ClusterTracker::ClusterTracker(ClusterTrackerOptions options) : options_(options), next_id_(options.first_id) {}
 
@@ -88,5 +88,5 @@ std::vector<ClusterTrack> ClusterTracker::confirmedTracks() const {
   return out;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -3,7 +3,7 @@
 #include <cmath>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 Eigen::Vector2d ScanCluster::centroid() const {
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
@@ -46,5 +46,5 @@ std::vector<ScanCluster> segmentScan(const core::LaserScan& scan, const Segmenta
   return out;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 namespace {
 
 cv::Mat toMat(const std::vector<LegFeatures>& samples) {
@@ -96,5 +96,5 @@ double LegClassifier::legProbability(const LegFeatures& features) const {
   return legProbability(std::vector<LegFeatures>{features}).front();
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -5,7 +5,7 @@
 #include <tuple>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 bool isLegCandidate(const ScanCluster& cluster, const LegDetectorOptions& options) {
   if (cluster.points.empty()) return false;
@@ -74,5 +74,5 @@ LegDetection LegDetector::detect(const core::LaserScan& scan) const {
   return out;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -6,7 +6,7 @@
 #include <cmath>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 namespace {
 
 double median(std::vector<double> v) {
@@ -133,5 +133,5 @@ std::string LegFeatures::name(int i) {
   return (i >= 0 && i < kCount) ? names[i] : "";
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

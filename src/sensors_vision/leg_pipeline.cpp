@@ -8,7 +8,7 @@
 #include "picker_localisation/core/yaml_keys.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 namespace {
 
@@ -226,5 +226,5 @@ std::size_t LegPipeline::liveTracks() const {
   return live;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -6,7 +6,7 @@
 #include "picker_localisation/sensors_vision/munkres.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
                             const LegDetectorOptions& options, double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels) {
@@ -61,5 +61,5 @@ LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<c
   return e;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

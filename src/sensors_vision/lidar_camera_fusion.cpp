@@ -5,7 +5,7 @@
 #include <set>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 namespace {
 
 double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
@@ -77,5 +77,5 @@ std::vector<FusedPerson> LidarCameraFusion::fuse(const std::vector<FusionCandida
   return out;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

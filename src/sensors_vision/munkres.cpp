@@ -4,7 +4,7 @@
 #include <stdexcept>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 // Hungarian algorithm, shortest augmenting path with row/column potentials (the O(n^3) form of Munkres'
 // method). The matrix is transposed when it has more rows than columns so that rows <= columns.
@@ -77,5 +77,5 @@ double assignmentCost(const Eigen::MatrixXd& cost, const std::vector<int>& row_t
   return total;
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

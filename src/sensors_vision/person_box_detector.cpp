@@ -13,7 +13,7 @@
 #include "picker_localisation/core/yaml_keys.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 std::vector<PersonBox> suppressOverlaps(std::vector<PersonBox> boxes, double iou) {
   std::stable_sort(boxes.begin(), boxes.end(),
@@ -225,5 +225,5 @@ double bearingFromColumnFov(double u, double horizontal_fov, int width) {
   return std::atan(2.0 * dx * std::tan(0.5 * horizontal_fov) / width);  // seed 004 Eq. 1
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -15,7 +15,7 @@ using namespace picker_localisation;
 
 int main(int argc, char** argv) {
   std::string bag, topic, out, model;
-  sensors::LegDetectorOptions options;
+  vision::LegDetectorOptions options;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string a = argv[i];
     if (a == "--bag") bag = argv[i + 1];
@@ -38,9 +38,9 @@ int main(int argc, char** argv) {
       if (pkg.empty()) throw std::runtime_error("package picker_localisation not found: give --model");
       model = pkg + "/config/leg_classifier.yml";
     }
-    auto classifier = std::make_shared<sensors::LegClassifier>();
+    auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(model);
-    sensors::LegDetector detector(classifier, options);
+    vision::LegDetector detector(classifier, options);
     const auto scans = ros_adapter::readBagScans(bag, {topic});
     if (scans.empty()) throw std::runtime_error("no sensor_msgs/LaserScan on " + topic + " in " + bag);
     std::ofstream csv(out);

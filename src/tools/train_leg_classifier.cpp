@@ -38,32 +38,32 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    std::vector<sensors::LabelledScan> train_pos, test_pos;
+    std::vector<vision::LabelledScan> train_pos, test_pos;
     for (int n = 1; n <= 4; ++n) {
       auto scans = ros_adapter::readLabelledLegBag(data + "/positive_" + std::to_string(n) + "_extracted.bag");
       auto& dst = n <= 3 ? train_pos : test_pos;
       dst.insert(dst.end(), scans.begin(), scans.end());
     }
     const auto neg = ros_adapter::readBagScans(data + "/negative_2.bag");
-    const std::size_t split = sensors::negativeTrainCount(neg.size());
+    const std::size_t split = vision::negativeTrainCount(neg.size());
     std::vector<core::LaserScan> train_neg, test_neg;
     for (std::size_t i = 0; i < neg.size(); ++i) (i < split ? train_neg : test_neg).push_back(neg[i].scan);
 
-    sensors::LegDetectorOptions options;
-    std::vector<sensors::LegFeatures> samples;
+    vision::LegDetectorOptions options;
+    std::vector<vision::LegFeatures> samples;
     std::vector<int> labels;
-    sensors::collectTrainingSamples(train_pos, train_neg, options, hit, kUnlabelledNegativeDistance, samples, labels);
+    vision::collectTrainingSamples(train_pos, train_neg, options, hit, kUnlabelledNegativeDistance, samples, labels);
     std::size_t npos = 0;
     for (int l : labels) npos += l;
     std::printf("training: %zu positive and %zu negative clusters (%zu + %zu scans)\n", npos, labels.size() - npos,
                 train_pos.size(), train_neg.size());
-    auto classifier = std::make_shared<sensors::LegClassifier>();
+    auto classifier = std::make_shared<vision::LegClassifier>();
     if (!dump.empty()) {
       std::ofstream csv(dump);
       csv << "set,label";
-      for (int k = 0; k < sensors::LegFeatures::kCount; ++k) csv << ',' << sensors::LegFeatures::name(k);
+      for (int k = 0; k < vision::LegFeatures::kCount; ++k) csv << ',' << vision::LegFeatures::name(k);
       csv << '\n';
-      auto write = [&](const char* set, const std::vector<sensors::LegFeatures>& f, const std::vector<int>& l) {
+      auto write = [&](const char* set, const std::vector<vision::LegFeatures>& f, const std::vector<int>& l) {
         for (std::size_t i = 0; i < f.size(); ++i) {
           csv << set << ',' << l[i];
           for (float v : f[i].values) csv << ',' << v;
@@ -71,19 +71,19 @@ int main(int argc, char** argv) {
         }
       };
       write("train", samples, labels);
-      std::vector<sensors::LegFeatures> ts;
+      std::vector<vision::LegFeatures> ts;
       std::vector<int> tl;
-      sensors::collectTrainingSamples(test_pos, test_neg, options, hit, kUnlabelledNegativeDistance, ts, tl);
+      vision::collectTrainingSamples(test_pos, test_neg, options, hit, kUnlabelledNegativeDistance, ts, tl);
       write("test", ts, tl);
     }
-    sensors::LegClassifierTrainingOptions topt;
+    vision::LegClassifierTrainingOptions topt;
     classifier->train(samples, labels, topt);
     classifier->save(out);
     std::printf("wrote %s\n", out.c_str());
 
-    sensors::LegDetector detector(classifier, options);
-    const auto e = sensors::evaluateLegs(detector, test_pos, hit);
-    const auto n = sensors::evaluateNegatives(detector, test_neg);
+    vision::LegDetector detector(classifier, options);
+    const auto e = vision::evaluateLegs(detector, test_pos, hit);
+    const auto n = vision::evaluateNegatives(detector, test_neg);
     std::printf("held out positive_4: %zu scans, %zu labels, %zu detections, recall %.3f, precision %.3f\n", e.scans,
                 e.labels, e.detections, e.recall(), e.precision());
     std::printf("held out negative_2 (last third): %zu scans, %.3f false legs per scan\n", n.scans,
@@ -92,9 +92,9 @@ int main(int argc, char** argv) {
       for (double th = 0.1; th < 0.95; th += 0.1) {
         auto o = options;
         o.leg_threshold = th;
-        sensors::LegDetector d(classifier, o);
-        const auto a = sensors::evaluateLegs(d, test_pos, hit);
-        const auto b = sensors::evaluateNegatives(d, test_neg);
+        vision::LegDetector d(classifier, o);
+        const auto a = vision::evaluateLegs(d, test_pos, hit);
+        const auto b = vision::evaluateNegatives(d, test_neg);
         std::printf("  threshold %.1f: recall %.3f precision %.3f false/scan %.3f\n", th, a.recall(), a.precision(),
                     b.detectionsPerScan());
       }

@@ -56,7 +56,7 @@ struct RunConfig {
   std::string gnss_config;         // GnssIngest options, config/gnss_ingest.yaml
   std::string rfid_config;         // RfidObservationModel options, config/rfid_ranging.yaml
   std::string nbs_config;          // planner of estimated_node / nbs, config/nbs.yaml
-  std::string vision_config;       // leg_detector section (sensors::LegPipelineOptions, as the node): "" =
+  std::string vision_config;       // leg_detector section (vision::LegPipelineOptions, as the node): "" =
                                   // config/vision.yaml, then the simulated-laser overlay config/vision_sim.yaml
                                   // (leg_threshold 0.3); else comma-separated files applied in order
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)

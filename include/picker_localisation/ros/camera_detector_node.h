@@ -31,7 +31,7 @@ class CameraDetectorNode {
 
   ros::NodeHandle nh_, pnh_;
   bool ok_ = false;
-  std::unique_ptr<sensors::PersonBoxDetector> detector_;
+  std::unique_ptr<vision::PersonBoxDetector> detector_;
   std::string robot_id_, bearing_frame_;
   double max_rate_ = 5.0, max_age_ = 0.5, horizontal_fov_ = 0.0;
   ros::Subscriber image_sub_, info_sub_;

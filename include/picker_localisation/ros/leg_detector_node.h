@@ -44,7 +44,7 @@ class LegDetectorNode {
               Eigen::Isometry3d& out);
   // Tracks, fuses and publishes the people of one scan / cloud (positions in the fixed frame).
   void publishPeople(const std::string& source_frame, const ros::Time& stamp,
-                     const std::vector<sensors::PersonCandidate>& people);
+                     const std::vector<vision::PersonCandidate>& people);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   // False (counted, throttled warning) for a stamp too far ahead of the clock; resets the time state once when
   // the clock jumped back.
@@ -56,8 +56,8 @@ class LegDetectorNode {
   double tf_timeout_ = 0.1, fusion_max_age_ = 0.5;
   int max_beams_ = 20000;  // ~max_beams: larger scans are dropped (0: any size)
   // Detector, per-sensor-frame trackers and camera fusion: the same core pipeline the offline runner uses.
-  std::unique_ptr<sensors::LegPipeline> pipeline_;
-  sensors::Cloud3dPersonDetector cloud_detector_;
+  std::unique_ptr<vision::LegPipeline> pipeline_;
+  vision::Cloud3dPersonDetector cloud_detector_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

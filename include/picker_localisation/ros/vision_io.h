@@ -26,7 +26,7 @@ std::vector<BagScan> readBagScans(const std::string& bag_path, const std::vector
 
 // A leg_tracker "positive_N_extracted" bag: the k-th /leg_cluster_positions PoseArray labels the k-th
 // /training_scan (both are written as one pair per scan by the extraction tool).
-std::vector<sensors::LabelledScan> readLabelledLegBag(const std::string& bag_path);
+std::vector<vision::LabelledScan> readLabelledLegBag(const std::string& bag_path);
 
 }  // namespace ros_adapter
 }  // namespace picker_localisation

@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct Cloud3dPersonOptions {
   double voxel_size = 0.05;          // m
@@ -41,5 +41,5 @@ class Cloud3dPersonDetector {
   Cloud3dPersonOptions options_;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

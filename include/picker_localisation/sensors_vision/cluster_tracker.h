@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct ClusterTrackerOptions {
   double gate_distance = 0.5;   // d_min: a detection farther than this from a track is never assigned to it, m
@@ -52,5 +52,5 @@ class ClusterTracker {
   bool has_stamp_ = false;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

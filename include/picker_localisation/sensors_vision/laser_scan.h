@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 // One segment of consecutive valid beams (Algorithm 3's c_j), in the scan's own frame.
 struct ScanCluster {
@@ -30,5 +30,5 @@ struct SegmentationOptions {
 // covers a full circle is not wrapped around; the first and last beams belong to different clusters.
 std::vector<ScanCluster> segmentScan(const core::LaserScan& scan, const SegmentationOptions& options = {});
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

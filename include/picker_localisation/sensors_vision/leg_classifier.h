@@ -10,7 +10,7 @@
 #include "picker_localisation/sensors_vision/leg_features.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct LegClassifierTrainingOptions {
   int num_trees = 50;          // forest size
@@ -42,5 +42,5 @@ class LegClassifier {
   cv::Ptr<cv::ml::RTrees> model_;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

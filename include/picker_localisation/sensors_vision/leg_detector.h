@@ -11,7 +11,7 @@
 #include "picker_localisation/sensors_vision/leg_classifier.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct Leg {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // cluster centroid, m, scan frame
@@ -60,5 +60,5 @@ class LegDetector {
   LegDetectorOptions options_;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

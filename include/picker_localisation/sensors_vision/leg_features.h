@@ -8,7 +8,7 @@
 #include "picker_localisation/sensors_vision/laser_scan.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct LegFeatures {
   // Shape only: the number of points and the distance from the sensor are left out on purpose (they depend on
@@ -28,5 +28,5 @@ struct LegFeatures {
   static std::string name(int i);
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

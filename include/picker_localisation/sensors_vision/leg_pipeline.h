@@ -24,7 +24,7 @@
 #include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct LegPipelineOptions {
   LegDetectorOptions detector;
@@ -114,5 +114,5 @@ class LegPipeline {
   std::size_t camera_confirmed_ = 0;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -9,7 +9,7 @@
 #include "picker_localisation/sensors_vision/leg_detector.h"
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct LabelledScan {
   core::LaserScan scan;
@@ -39,11 +39,11 @@ LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<Labell
 // Scans with no people: every leg detected is false.
 LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<core::LaserScan>& scans);
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 // The fixed held-out split used by train_leg_classifier and the real-data tests: labelled positives
 // positive_1..3 train, positive_4 is held out; of the negative bag (all laser topics in recording order) the
@@ -53,5 +53,5 @@ inline std::size_t negativeTrainCount(std::size_t total) {
   return static_cast<std::size_t>(static_cast<double>(total) * kNegativeTrainFraction);
 }
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

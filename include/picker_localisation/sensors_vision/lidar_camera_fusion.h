@@ -11,7 +11,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 // A camera bearing cone, in the frame of the candidates (x forward, y left; angles positive to the left).
 struct BearingCone {
@@ -66,5 +66,5 @@ class LidarCameraFusion {
   std::map<int, TrackState> state_;
 };
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

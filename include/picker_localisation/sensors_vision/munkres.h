@@ -7,7 +7,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 // Minimum-cost assignment of rows to columns of an n x m matrix of finite costs. Returns, for each row, the
 // assigned column or -1 (when n > m some rows stay unassigned). min(n, m) pairs are always assigned.
@@ -17,5 +17,5 @@ std::vector<int> solveAssignment(const Eigen::MatrixXd& cost);
 // Total cost of an assignment returned by solveAssignment().
 double assignmentCost(const Eigen::MatrixXd& cost, const std::vector<int>& row_to_col);
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation

@@ -10,7 +10,7 @@
 #include <vector>
 
 namespace picker_localisation {
-namespace sensors {
+namespace vision {
 
 struct PersonBox {
   cv::Rect box;             // pixels of the original image
@@ -115,5 +115,5 @@ double bearingFromColumnFov(double u, double horizontal_fov, int width);
 // Greedy non-maximum suppression: keeps the most confident box of each group overlapping more than iou.
 std::vector<PersonBox> suppressOverlaps(std::vector<PersonBox> boxes, double iou);
 
-}  // namespace sensors
+}  // namespace vision
 }  // namespace picker_localisation
