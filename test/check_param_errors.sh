@@ -2,7 +2,7 @@
 # Issue "One options schema": a node given an out-of-range parameter stops with one FATAL line naming the key,
 # the value and the allowed range (exit status 1); a node given an unknown parameter (a typo) warns once, naming
 # the closest known key, and keeps running. Checked for leg_detector, gnss_ingest and tpf_tracker against a real
-# rosmaster (and the FATAL line of uwb_ranging, rfid_ranging, camera_detector, farm_sim and the evaluator). Usage: check_param_errors.sh PACKAGE_DIR (run through the devel space's env.sh).
+# rosmaster (and the FATAL line of uwb_ranging, rfid_ranging, camera_detector, topological_map_server, farm_sim and the evaluator). Usage: check_param_errors.sh PACKAGE_DIR (run through the devel space's env.sh).
 set -u
 pkg="$1"
 map="$pkg/config/maps/riseholme.tmap2"
@@ -62,6 +62,7 @@ expect_warning tpf_tracker num_particle "unknown key 'num_particle' (did you mea
 expect_fatal uwb_ranging p_min_uwb 2 "p_min_uwb = 2: must be in (0, 1\]" "${common_tpf[@]}"
 expect_fatal rfid_ranging d50 -1 "d50 = -1: must be finite and > 0" "${common_tpf[@]}"
 expect_fatal camera_detector resize 0 "resize = 0: must be in (0, 4\]"
+expect_fatal topological_map_server node_scale 0 "node_scale = 0: must be finite and > 0" _map_file:="$map"
 expect_fatal farm_sim clock_step 0 "clock_step = 0: must be finite and > 0" _map_file:="$map"
 expect_fatal evaluator sample_rate -1 "sample_rate = -1: must be finite and > 0" _map_file:="$map"
 expect_warning evaluator sampel_rate "unknown key 'sampel_rate' (did you mean 'sample_rate'?)" _map_file:="$map" \

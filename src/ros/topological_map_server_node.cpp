@@ -1,6 +1,10 @@
 #include "picker_localisation/ros/topological_map_server_node.h"
 
+#include <cmath>
+
+#include "picker_localisation/core/yaml_keys.h"
 #include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/topology/map_io.h"
 
@@ -18,6 +22,14 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
   pnh.param<std::string>("frame_id", frame_id, "map");
   pnh.param("node_scale", node_scale, node_scale);
   pnh.param("labels", labels, labels);
+  // Its four keys: a typo is one warning naming the closest, a bad scale one FATAL line (as every node).
+  for (const auto& u : core::unknownKeys(paramsAsYaml(pnh), {"map_file", "frame_id", "node_scale", "labels"},
+                                         "topological_map_server"))
+    ROS_WARN("%s", u.c_str());
+  if (!(node_scale > 0.0) || !std::isfinite(node_scale)) {
+    ROS_FATAL("topological_map_server: %s", core::badValue("node_scale", node_scale, "finite and > 0").c_str());
+    return;
+  }
   try {
     const topology::TopologicalMap map = topology::loadMap(map_file);
     msg_ = toMsg(map, frame_id);
