@@ -26,16 +26,11 @@ EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "ordering_latency", o.ordering_latency);
   core::readOption(y, c, "max_truth_distance", o.max_truth_distance);
   core::readOption(y, c, "max_future_stamp", o.max_future_stamp);
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  if (unknown) {
-    static const std::vector<std::string> known{
+  static const std::vector<std::string> known{
         "pickers_file",       "sample_rate",      "duration", "output_csv",    "ordering_latency",
         "max_truth_distance", "max_future_stamp", "map_file", "map_topic",     "belief_topic",
         "registry_topic"};
-    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
-  }
-  return o;
+  return core::checkOptions(o, y, known, c, unknown);
 }
 
 std::string EvaluatorOptions::validate() const {

@@ -105,17 +105,12 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
   core::readOption(y, c, "ground_truth_rate", o.ground_truth_rate);
   core::readOption(y, c, "publish_sensor_frames", o.publish_sensor_frames);
   core::readOption(y, c, "map_frame", o.map_frame);
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  if (unknown) {
-    static const std::vector<std::string> known{
+  static const std::vector<std::string> known{
         "sim_config",   "urdf_template", "pickers_file", "datum_file",   "datum_source",     "seed",
         "robots",       "robot_speed",   "patrol",       "enable_gnss",  "enable_laser",     "enable_rfid",
         "enable_uwb",   "enable_camera", "rate_factor",  "duration",     "clock_step",       "start_time",
         "ground_truth_rate", "publish_sensor_frames", "map_frame", "map_file", "map_topic"};
-    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
-  }
-  return o;
+  return core::checkOptions(o, y, known, c, unknown);
 }
 
 std::string FarmSimOptions::validate() const {

@@ -38,10 +38,7 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
   count("jump_reset_count", o.jump_reset_count);
   o.bias = GnssBiasOptions::fromYaml(y);
   o.association = PickerAssociationOptions::fromYaml(y);
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  if (unknown) {
-    std::vector<std::string> known = {
+  std::vector<std::string> known = {
         "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
         "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
         "blackout_timeout", "max_map_distance", "pickers_file", "datum_file",        "datum_source",      "map_file",
@@ -49,12 +46,9 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
         "people_pose_topics", "people_pose_sensor", "people_pose_sigma", "pose_topic_format", "pose_sensor",
         "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
         "on_demand_topics_above", "demand_poll_period"};
-    known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
-    known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
-                 PickerAssociationOptions::yamlKeys().end());
-    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
-  }
-  return o;
+  known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
+  known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(), PickerAssociationOptions::yamlKeys().end());
+  return core::checkOptions(o, y, known, c, unknown);
 }
 
 GnssIngestOptions GnssIngestOptions::fromYamlFile(const std::string& path,

@@ -32,8 +32,7 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "p_detect", o.p_detect);
   core::readOption(y, c, "attempt_rate", o.attempt_rate);
   core::readOption(y, c, "max_failed_attempts", o.max_failed_attempts);
-  if (unknown) {
-    const std::vector<std::string> known = {"read_model",
+  static const std::vector<std::string> known = {"read_model",
                                             "p_max",
                                             "d50",
                                             "width",
@@ -61,11 +60,7 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                             "silent_warn_after",
                                             "max_future_stamp",
                                             "registry_topic"};
-    for (auto& m : core::unknownKeys(y, known, c)) unknown->push_back(std::move(m));
-  }
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  return o;
+  return core::checkOptions(o, y, known, c, unknown);
 }
 
 std::string RfidModelOptions::validate() const {

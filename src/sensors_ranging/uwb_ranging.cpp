@@ -89,11 +89,7 @@ UwbRangingOptions UwbRangingOptions::fromYaml(const YAML::Node& y, std::vector<s
   core::readOption(y, c, "cutoff_sigmas", o.cutoff_sigmas);
   core::readOption(y, c, "reset_after", o.reset_after);
   core::readOption(y, c, "max_output_sigma", o.max_output_sigma);
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  if (unknown)
-    for (auto& m : core::unknownKeys(y, yamlKeys(), c)) unknown->push_back(std::move(m));
-  return o;
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
 }
 
 UwbRangingOptions UwbRangingOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {

@@ -71,11 +71,7 @@ CameraDetectorOptions CameraDetectorOptions::fromYaml(const YAML::Node& y, std::
   core::readOption(y, c, "bearing_frame", o.bearing_frame);
   core::readOption(y, c, "robot_id", o.robot_id);
   o.onnx.model_path = o.onnx_model;
-  const std::string problem = o.validate();
-  if (!problem.empty()) throw std::runtime_error(c + ": " + problem);
-  if (unknown)
-    for (auto& m : core::unknownKeys(y, yamlKeys(), c)) unknown->push_back(std::move(m));
-  return o;
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
 }
 
 CameraDetectorOptions CameraDetectorOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {

@@ -21,6 +21,19 @@ std::vector<std::string> unknownKeys(const YAML::Node& node, const std::vector<s
 // The message of a validate() that refuses a value: "<key> = <value>: must be <rule>".
 std::string badValue(const char* key, double value, const char* rule);
 
+// The end of an Options::fromYaml(node, &unknown): throws std::runtime_error "<component>: <problem>" when
+// o.validate() refuses a value, then appends one message per key of `node` not in `known` to *unknown (when
+// given). Returns o.
+template <class Options>
+Options checkOptions(Options o, const YAML::Node& node, const std::vector<std::string>& known,
+                     const std::string& component, std::vector<std::string>* unknown) {
+  const std::string problem = o.validate();
+  if (!problem.empty()) throw std::runtime_error(component + ": " + problem);
+  if (unknown)
+    for (auto& m : unknownKeys(node, known, component)) unknown->push_back(std::move(m));
+  return o;
+}
+
 // Sets `value` from node[key] when present; a value of the wrong type throws std::runtime_error
 // "<component>: key '<key>' has the wrong type".
 template <typename T>
