@@ -11,7 +11,8 @@ add_library(picker_localisation_vision
   src/sensors_vision/lidar_camera_fusion.cpp
   src/sensors_vision/leg_pipeline.cpp
   src/sensors_vision/cloud3d_person_detector.cpp
-  src/sensors_vision/person_box_detector.cpp)
+  src/sensors_vision/person_box_detector.cpp
+  src/sensors_vision/box_evaluation.cpp)
 target_include_directories(picker_localisation_vision SYSTEM PUBLIC ${OpenCV_INCLUDE_DIRS} ${PCL_INCLUDE_DIRS})
 target_compile_definitions(picker_localisation_vision PUBLIC ${PCL_DEFINITIONS})
 target_link_libraries(picker_localisation_vision PUBLIC picker_localisation_core ${OpenCV_LIBS} ${PCL_LIBRARIES})

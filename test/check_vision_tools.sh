@@ -22,7 +22,13 @@ fi
 "$2" --video /usr/share/doc/opencv-doc/examples/data/vtest.avi --out "$tmp/video.csv" --resize 1.5 --max-frames 2 >/dev/null
 [ "$(head -1 "$tmp/video.csv")" = "frame,x,y,width,height,confidence" ] || { echo "bad people header"; exit 1; }
 [ "$(sed -n 2p "$tmp/video.csv" | cut -d, -f1)" = "0" ] || { echo "first video row is not frame 0"; exit 1; }
+# Scored against the hand labels: the table header and one row for the labelled frames among the first 200.
+"$2" --video /usr/share/doc/opencv-doc/examples/data/vtest.avi --labels "$3/test/data/vtest_people.csv" \
+  --max-frames 3 > "$tmp/score.md"
+grep -q "^| option | min_confidence | recall | precision" "$tmp/score.md" || { echo "no score table"; cat "$tmp/score.md"; exit 1; }
+grep -q "^| default, resize 1.50, scale 1.10" "$tmp/score.md" || { echo "no score row"; cat "$tmp/score.md"; exit 1; }
 set +e
 "$1" --bag /nonexistent.bag >/dev/null 2>&1; [ $? -eq 2 ] || { echo "usage error not 2"; exit 1; }
 "$2" --images "$tmp/images" >/dev/null 2>&1; [ $? -eq 2 ] || { echo "usage error not 2"; exit 1; }
+"$2" --images "$tmp/images" --sweep >/dev/null 2>&1; [ $? -eq 2 ] || { echo "sweep without labels not 2"; exit 1; }
 echo "vision tools ok ($rows legs)"

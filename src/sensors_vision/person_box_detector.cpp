@@ -43,7 +43,7 @@ struct HogPersonDetector::Impl {
 };
 
 const std::vector<std::string>& CameraDetectorOptions::yamlKeys() {
-  static const std::vector<std::string> keys{"onnx_model",        "resize",           "hit_threshold",
+  static const std::vector<std::string> keys{"onnx_model",        "hog_model",        "resize",           "hit_threshold",
                                              "min_confidence",    "scale",            "onnx_input_width",
                                              "onnx_input_height", "onnx_person_class", "max_rate",
                                              "max_age",           "max_future_stamp", "horizontal_fov",
@@ -56,6 +56,7 @@ CameraDetectorOptions CameraDetectorOptions::fromYaml(const YAML::Node& y, std::
   if (!y || !y.IsMap()) return o;
   const std::string c = "camera_detector";
   core::readOption(y, c, "onnx_model", o.onnx_model);
+  core::readOption(y, c, "hog_model", o.hog.model);
   core::readOption(y, c, "resize", o.hog.resize);
   core::readOption(y, c, "hit_threshold", o.hog.hit_threshold);
   core::readOption(y, c, "scale", o.hog.scale);
@@ -80,6 +81,9 @@ CameraDetectorOptions CameraDetectorOptions::fromYamlFile(const std::string& pat
 
 std::string CameraDetectorOptions::validate() const {
   const auto bad = core::badValue;
+  const auto& models = HogOptions::models();
+  if (std::find(models.begin(), models.end(), hog.model) == models.end())
+    return "hog_model = " + hog.model + ": must be default or daimler";
   if (!(hog.resize > 0.0 && hog.resize <= 4.0)) return bad("resize", hog.resize, "in (0, 4]");
   if (!(hog.scale > 1.0 && hog.scale <= 2.0)) return bad("scale", hog.scale, "in (1, 2]");
   if (!std::isfinite(hog.hit_threshold)) return bad("hit_threshold", hog.hit_threshold, "finite");
@@ -99,17 +103,28 @@ std::unique_ptr<PersonBoxDetector> CameraDetectorOptions::makeDetector() const {
   return std::make_unique<OnnxPersonDetector>(onnx);
 }
 
+const std::vector<std::string>& HogOptions::models() {
+  static const std::vector<std::string> names{"default", "daimler"};
+  return names;
+}
+
 HogPersonDetector::HogPersonDetector(HogOptions options) : options_(options), impl_(std::make_shared<Impl>()) {
-  impl_->hog.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector());
+  if (options_.model == "default") {
+    impl_->hog.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector());
+  } else if (options_.model == "daimler") {
+    // The Daimler SVM's descriptor: 48 x 96 window, 16 px blocks, 8 px stride and cells, 9 bins.
+    impl_->hog = cv::HOGDescriptor(cv::Size(48, 96), cv::Size(16, 16), cv::Size(8, 8), cv::Size(8, 8), 9);
+    impl_->hog.setSVMDetector(cv::HOGDescriptor::getDaimlerPeopleDetector());
+  } else {
+    throw std::invalid_argument("HogPersonDetector: unknown model '" + options_.model + "' (default or daimler)");
+  }
 }
 
 std::vector<PersonBox> HogPersonDetector::detect(const cv::Mat& bgr) const {
   std::vector<PersonBox> out;
   if (bgr.empty()) return out;
   cv::Mat img = bgr;
-  double factor = options_.resize > 0.0 ? options_.resize : 1.0;
-  if (options_.max_width > 0 && bgr.cols * factor > options_.max_width)
-    factor = static_cast<double>(options_.max_width) / bgr.cols;
+  const double factor = options_.resize > 0.0 ? options_.resize : 1.0;
   if (std::abs(factor - 1.0) > 1e-9)
     cv::resize(bgr, img, cv::Size(), factor, factor, factor < 1.0 ? cv::INTER_AREA : cv::INTER_LINEAR);
   // An image smaller than the HOG window holds no person; OpenCV 4.6 crashes on it (bug #8793), so it is not

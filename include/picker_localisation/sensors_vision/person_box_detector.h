@@ -24,17 +24,26 @@ class PersonBoxDetector {
 };
 
 struct HogOptions {
-  double scale = 1.05;            // detectMultiScale pyramid step
-  double hit_threshold = 0.0;     // SVM margin threshold
-  double resize = 1.0;            // image resize factor before detection (boxes are scaled back); > 1 finds people
-                                  // smaller than the 64 x 128 px HOG window
-  int max_width = 1280;           // the resized image is capped at this width, px
-  double min_confidence = 0.3;    // boxes below this confidence are dropped
+  std::string model = "default";  // OpenCV's built-in people SVM: "default" (64 x 128 px window, Dalal-Triggs)
+                                  // or "daimler" (48 x 96 px window); neither needs a download
+  // Defaults: the best of the options measured with `detect_people --sweep` on 12 hand-labelled vtest.avi frames
+  // (docs/readme/sensors_vision.md, "Camera options"): 1.5x upscaling finds the 55-110 px people of street-scale
+  // frames (native: half of them), the coarser pyramid step 1.10 pays for it (about 1.2x the cost of one native
+  // pass at 1.05), a slightly negative SVM threshold with a confidence cut keeps recall and precision >= 0.85.
+  double scale = 1.10;            // detectMultiScale pyramid step
+  double hit_threshold = -0.2;    // SVM margin threshold
+  double resize = 1.5;            // image resize factor before detection (boxes are scaled back); > 1 finds people
+                                  // smaller than the detection window. Applied as given (no cap): the cost grows
+                                  // with resize^2 / log(scale)
+  double min_confidence = 0.5;    // boxes below this confidence are dropped
   double nms_iou = 0.4;           // non-maximum suppression overlap
   double confidence_scale = 1.0;  // confidence = 1 - exp(-weight / scale) for the SVM weight
+
+  static const std::vector<std::string>& models();  // the accepted values of `model`
 };
 
-// cv::HOGDescriptor with getDefaultPeopleDetector() (no weights to download).
+// cv::HOGDescriptor with OpenCV's built-in people SVM named by HogOptions::model (no weights to download). The
+// constructor throws std::invalid_argument for an unknown model.
 class HogPersonDetector : public PersonBoxDetector {
  public:
   explicit HogPersonDetector(HogOptions options = {});
@@ -78,7 +87,7 @@ class OnnxPersonDetector : public PersonBoxDetector {
 // parameters (same keys). min_confidence applies to the detector in use (HOG default 0.3, ONNX 0.5).
 struct CameraDetectorOptions {
   std::string onnx_model;       // "" = OpenCV's HOG people detector, else an SSD-style ONNX file (OnnxOptions)
-  HogOptions hog;               // keys resize, hit_threshold, min_confidence, scale
+  HogOptions hog;               // keys hog_model, resize, hit_threshold, min_confidence, scale
   OnnxOptions onnx;             // keys onnx_input_width, onnx_input_height, onnx_person_class, min_confidence
   double max_rate = 5.0;  // Hz, frames closer than 1 / max_rate to the last processed one are dropped (0: none)
   double max_age = 0.5;   // s, frames older than this are dropped (0: none)
