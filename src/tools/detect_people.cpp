@@ -1,14 +1,16 @@
 // Offline person boxes on a video or a folder of images:
-//   detect_people --video FILE | --images DIR --out FILE.csv [--model default|daimler] [--resize F] [--scale S]
+//   detect_people --video FILE | --images DIR --out FILE.csv [--model default|daimler] [--resize F] [--scale
+//   S]
 //                 [--hit-threshold T] [--min-confidence C] [--onnx MODEL.onnx] [--max-frames N]
-// CSV: frame,x,y,width,height,confidence (frame: the image's file name, or the video frame index; x, y: top-left
-// corner in pixels of the original image). HOG people detector (config/vision.yaml's camera_detector defaults)
-// unless --onnx is given.
-// Scored against hand labels (frame,x1,y1,x2,y2,person|ignore; e.g. test/data/vtest_people.csv), only the labelled
-// frames are run:
-//   detect_people --video FILE --labels LABELS.csv [options]   -> recall, precision, false boxes and ms per frame
-//   detect_people --video FILE --labels LABELS.csv --sweep     -> that table for every HOG option set below, each
-//                 row at several confidence cuts, the cost relative to one native default-HOG pass in the same run
+// CSV: frame,x,y,width,height,confidence (frame: the image's file name, or the video frame index; x, y:
+// top-left corner in pixels of the original image). HOG people detector (config/vision.yaml's camera_detector
+// defaults) unless --onnx is given. Scored against hand labels (frame,x1,y1,x2,y2,person|ignore; e.g.
+// test/data/vtest_people.csv), only the labelled frames are run:
+//   detect_people --video FILE --labels LABELS.csv [options]   -> recall, precision, false boxes and ms per
+//   frame detect_people --video FILE --labels LABELS.csv --sweep     -> that table for every HOG option set
+//   below, each
+//                 row at several confidence cuts, the cost relative to one native default-HOG pass in the
+//                 same run
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -33,11 +35,12 @@ struct Frame {
   cv::Mat image;
 };
 
-// Calls fn(name, image) for every frame of a video or image folder (only the frames in `wanted` when it is not
-// empty), up to max_frames (0: all).
+// Calls fn(name, image) for every frame of a video or image folder (only the frames in `wanted` when it is
+// not empty), up to max_frames (0: all).
 template <typename Fn>
 void forEachFrame(const std::string& video, const std::string& images,
-                  const std::map<std::string, std::vector<LabelledPerson>>& wanted, std::size_t max_frames, Fn fn) {
+                  const std::map<std::string, std::vector<LabelledPerson>>& wanted, std::size_t max_frames,
+                  Fn fn) {
   std::size_t count = 0;
   auto keep = [&](const std::string& name) { return wanted.empty() || wanted.count(name) > 0; };
   auto full = [&] { return max_frames > 0 && count >= max_frames; };
@@ -66,8 +69,8 @@ void forEachFrame(const std::string& video, const std::string& images,
   }
 }
 
-// Runs the detector on every frame (timed: the tool's own wall clock, never inside the detector) and scores the
-// boxes of confidence >= each cut.
+// Runs the detector on every frame (timed: the tool's own wall clock, never inside the detector) and scores
+// the boxes of confidence >= each cut.
 std::vector<BoxScore> score(const PersonBoxDetector& detector, const std::vector<Frame>& frames,
                             const std::map<std::string, std::vector<LabelledPerson>>& labels,
                             const std::vector<double>& cuts) {
@@ -92,8 +95,8 @@ std::vector<BoxScore> score(const PersonBoxDetector& detector, const std::vector
 
 std::string describe(const HogOptions& o) {
   char name[96];
-  std::snprintf(name, sizeof name, "%s, resize %.2f, scale %.2f, hit_threshold %.1f", o.model.c_str(), o.resize,
-                o.scale, o.hit_threshold);
+  std::snprintf(name, sizeof name, "%s, resize %.2f, scale %.2f, hit_threshold %.1f", o.model.c_str(),
+                o.resize, o.scale, o.hit_threshold);
   return name;
 }
 
@@ -105,10 +108,12 @@ void printRow(const std::string& option, double cut, const BoxScore& s, double b
 }
 
 const char* kTableHeader =
-    "| option | min_confidence | recall | precision | false boxes / frame | ms / frame | cost vs native default |\n"
+    "| option | min_confidence | recall | precision | false boxes / frame | ms / frame | cost vs native "
+    "default |\n"
     "|---|---|---|---|---|---|---|\n";
 
-int sweep(const std::vector<Frame>& frames, const std::map<std::string, std::vector<LabelledPerson>>& labels) {
+int sweep(const std::vector<Frame>& frames,
+          const std::map<std::string, std::vector<LabelledPerson>>& labels) {
   struct Setting {
     std::string name;
     HogOptions options;
@@ -163,43 +168,56 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "detect_people: %s needs a value\n", a.c_str());
       return 2;
     }
-    if (a == "--video") video = argv[i + 1];
-    else if (a == "--images") images = argv[i + 1];
-    else if (a == "--out") out = argv[i + 1];
-    else if (a == "--resize") hog.resize = std::stod(argv[i + 1]);
-    else if (a == "--model") hog.model = argv[i + 1];
-    else if (a == "--scale") hog.scale = std::stod(argv[i + 1]);
-    else if (a == "--hit-threshold") hog.hit_threshold = std::stod(argv[i + 1]);
-    else if (a == "--min-confidence") hog.min_confidence = std::stod(argv[i + 1]);
-    else if (a == "--labels") labels_file = argv[i + 1];
-    else if (a == "--onnx") onnx = argv[i + 1];
-    else if (a == "--max-frames") max_frames = std::stoul(argv[i + 1]);
+    if (a == "--video")
+      video = argv[i + 1];
+    else if (a == "--images")
+      images = argv[i + 1];
+    else if (a == "--out")
+      out = argv[i + 1];
+    else if (a == "--resize")
+      hog.resize = std::stod(argv[i + 1]);
+    else if (a == "--model")
+      hog.model = argv[i + 1];
+    else if (a == "--scale")
+      hog.scale = std::stod(argv[i + 1]);
+    else if (a == "--hit-threshold")
+      hog.hit_threshold = std::stod(argv[i + 1]);
+    else if (a == "--min-confidence")
+      hog.min_confidence = std::stod(argv[i + 1]);
+    else if (a == "--labels")
+      labels_file = argv[i + 1];
+    else if (a == "--onnx")
+      onnx = argv[i + 1];
+    else if (a == "--max-frames")
+      max_frames = std::stoul(argv[i + 1]);
     else {
       std::fprintf(stderr, "detect_people: unknown option %s\n", a.c_str());
       return 2;
     }
   }
-  if ((out.empty() && labels_file.empty()) || video.empty() == images.empty() || (do_sweep && labels_file.empty())) {
-    std::fprintf(stderr,
-                 "usage: detect_people --video FILE|--images DIR (--out FILE.csv | --labels LABELS.csv [--sweep])\n"
-                 "       [--model default|daimler] [--resize F] [--scale S] [--hit-threshold T] [--min-confidence C]\n"
-                 "       [--onnx M] [--max-frames N]\n");
+  if ((out.empty() && labels_file.empty()) || video.empty() == images.empty() ||
+      (do_sweep && labels_file.empty())) {
+    std::fprintf(
+        stderr,
+        "usage: detect_people --video FILE|--images DIR (--out FILE.csv | --labels LABELS.csv [--sweep])\n"
+        "       [--model default|daimler] [--resize F] [--scale S] [--hit-threshold T] [--min-confidence C]\n"
+        "       [--onnx M] [--max-frames N]\n");
     return 2;
   }
   try {
     if (!labels_file.empty()) {
       const auto labels = labelsByFrame(readPeopleLabels(labels_file));
       std::vector<Frame> frames;
-      forEachFrame(video, images, labels, max_frames,
-                   [&](const std::string& name, const cv::Mat& img) { frames.push_back({name, img.clone()}); });
+      forEachFrame(video, images, labels, max_frames, [&](const std::string& name, const cv::Mat& img) {
+        frames.push_back({name, img.clone()});
+      });
       if (frames.empty()) throw std::runtime_error("no labelled frame found in the input");
       if (do_sweep) return sweep(frames, labels);
       const auto detector = makeDetector(hog, onnx);
       const double cut = 0.0;  // the detector applies its own min_confidence
       const auto s = score(*detector, frames, labels, {cut}).front();
       std::printf("%zu frames\n%s", frames.size(), kTableHeader);
-      printRow(onnx.empty() ? describe(hog) : onnx,
-               onnx.empty() ? hog.min_confidence : 0.5, s, 0.0);
+      printRow(onnx.empty() ? describe(hog) : onnx, onnx.empty() ? hog.min_confidence : 0.5, s, 0.0);
       return 0;
     }
     const auto detector = makeDetector(hog, onnx);

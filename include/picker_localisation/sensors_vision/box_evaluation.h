@@ -33,10 +33,10 @@ bool boxMatchesPerson(const cv::Rect& detection, const cv::Rect& person);
 
 struct BoxScore {
   std::size_t frames = 0;
-  std::size_t people = 0;       // labelled people (ignore labels excluded)
-  std::size_t found = 0;        // people matched by a detection (one detection per person)
-  std::size_t detections = 0;   // detections counted (those on ignore labels excluded)
-  double seconds = 0.0;         // detection time, summed over frames (filled by the caller)
+  std::size_t people = 0;      // labelled people (ignore labels excluded)
+  std::size_t found = 0;       // people matched by a detection (one detection per person)
+  std::size_t detections = 0;  // detections counted (those on ignore labels excluded)
+  double seconds = 0.0;        // detection time, summed over frames (filled by the caller)
 
   double recall() const { return people ? static_cast<double>(found) / people : 0.0; }
   double precision() const { return detections ? static_cast<double>(found) / detections : 1.0; }
@@ -45,10 +45,11 @@ struct BoxScore {
   void add(const BoxScore& other);
 };
 
-// Scores one frame's detections: in decreasing confidence, each detection takes the unmatched person it matches
-// with the largest overlap; a detection matching no free person but an ignore label is not counted; any other
-// is a false box (a second box on one person included).
-BoxScore scoreFrame(const std::vector<PersonBox>& detections, const std::vector<LabelledPerson>& frame_labels);
+// Scores one frame's detections: in decreasing confidence, each detection takes the unmatched person it
+// matches with the largest overlap; a detection matching no free person but an ignore label is not counted;
+// any other is a false box (a second box on one person included).
+BoxScore scoreFrame(const std::vector<PersonBox>& detections,
+                    const std::vector<LabelledPerson>& frame_labels);
 
 }  // namespace vision
 }  // namespace picker_localisation
