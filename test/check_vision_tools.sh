@@ -22,6 +22,12 @@ fi
 "$2" --video /usr/share/doc/opencv-doc/examples/data/vtest.avi --out "$tmp/video.csv" --resize 1.5 --max-frames 2 >/dev/null
 [ "$(head -1 "$tmp/video.csv")" = "frame,x,y,width,height,confidence" ] || { echo "bad people header"; exit 1; }
 [ "$(sed -n 2p "$tmp/video.csv" | cut -d, -f1)" = "0" ] || { echo "first video row is not frame 0"; exit 1; }
+# The recall vs false-legs curve of the labelled and the no-people recording: header and the seven thresholds.
+D="$4/leg_tracker/rosbags/training_scans_res=0.33"
+"$1" --curve --labelled "$D/positive_4_extracted.bag" --negatives "$D/negative_2.bag" --negatives-from 0.9 \
+  --model "$3/config/leg_classifier.yml" > "$tmp/curve.md"
+grep -q "^| setting | leg_threshold | leg recall | precision | false legs / scan" "$tmp/curve.md" || { echo "no curve header"; cat "$tmp/curve.md"; exit 1; }
+[ "$(grep -c '^| min_cluster_points 3, all beams | 0\.[2-8] |' "$tmp/curve.md")" -eq 7 ] || { echo "curve rows"; cat "$tmp/curve.md"; exit 1; }
 # Scored against the hand labels: the table header and one row for the labelled frames among the first 200.
 "$2" --video /usr/share/doc/opencv-doc/examples/data/vtest.avi --labels "$3/test/data/vtest_people.csv" \
   --max-frames 3 > "$tmp/score.md"
@@ -29,6 +35,7 @@ grep -q "^| option | min_confidence | recall | precision" "$tmp/score.md" || { e
 grep -q "^| default, resize 1.50, scale 1.10" "$tmp/score.md" || { echo "no score row"; cat "$tmp/score.md"; exit 1; }
 set +e
 "$1" --bag /nonexistent.bag >/dev/null 2>&1; [ $? -eq 2 ] || { echo "usage error not 2"; exit 1; }
+"$1" --curve --negatives /nonexistent.bag >/dev/null 2>&1; [ $? -eq 2 ] || { echo "curve without labels not 2"; exit 1; }
 "$2" --images "$tmp/images" >/dev/null 2>&1; [ $? -eq 2 ] || { echo "usage error not 2"; exit 1; }
 "$2" --images "$tmp/images" --sweep >/dev/null 2>&1; [ $? -eq 2 ] || { echo "sweep without labels not 2"; exit 1; }
 echo "vision tools ok ($rows legs)"

@@ -335,3 +335,29 @@ TEST(OnnxPersonDetector, GeneratedModelGivesItsBoxAndAWrongShapeIsRefused) {
   missing.model_path = std::string(PL_TEST_ONNX_DIR) + "/no_such_model.onnx";
   EXPECT_NE(refusal(missing).find("cannot read"), std::string::npos) << refusal(missing);
 }
+
+TEST(LegDetectorThreshold, ScaledDownForCoarserLasersOnly) {
+  LegDetectorOptions o;  // 0.6 at 0.006136 rad
+  EXPECT_DOUBLE_EQ(thresholdFor(o, 0.006136), 0.6);
+  EXPECT_DOUBLE_EQ(thresholdFor(o, 0.004363), 0.6);            // a finer laser keeps the threshold
+  EXPECT_NEAR(thresholdFor(o, 2 * 0.006136), 0.3, 1e-12);      // twice the spacing: half the threshold
+  EXPECT_NEAR(thresholdFor(o, -2 * 0.006136), 0.3, 1e-12);     // a scan turning clockwise
+  EXPECT_NEAR(thresholdFor(o, 0.00872665), 0.6 * 0.006136 / 0.00872665, 1e-12);
+  o.threshold_reference_increment = 0.0;
+  EXPECT_DOUBLE_EQ(thresholdFor(o, 0.1), 0.6);                  // scaling off
+  EXPECT_DOUBLE_EQ(thresholdFor(LegDetectorOptions{}, 0.0), 0.6);  // no increment given
+}
+
+TEST(Segmentation, DecimatedScanKeepsEveryKthBeam) {
+  core::LaserScan s;
+  s.angle_min = -1.0;
+  s.angle_increment = 0.01;
+  s.range_max = 10.0;
+  for (int i = 0; i < 7; ++i) s.ranges.push_back(1.0f + i);
+  const auto d = decimateScan(s, 3);
+  ASSERT_EQ(d.ranges.size(), 3u);  // beams 0, 3, 6
+  EXPECT_FLOAT_EQ(d.ranges[1], 4.0f);
+  EXPECT_DOUBLE_EQ(d.angle_increment, 0.03);
+  EXPECT_DOUBLE_EQ(d.angle(2), s.angle(6));
+  EXPECT_EQ(decimateScan(s, 1).ranges.size(), 7u);
+}

@@ -133,7 +133,7 @@ std::string resolveConfigFile(const std::string& value, const std::string& packa
 }
 
 // The leg_detector node's options from the `leg_detector:` section of config/vision.yaml and, as demo.launch
-// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.3: the
+// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.42, 0.3 at its 0.5 deg: the
 // classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files override earlier ones.
 std::vector<std::string> visionConfigFiles(const std::string& value) {
   std::vector<std::string> files;

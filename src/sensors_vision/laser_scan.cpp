@@ -46,5 +46,16 @@ std::vector<ScanCluster> segmentScan(const core::LaserScan& scan, const Segmenta
   return out;
 }
 
+core::LaserScan decimateScan(const core::LaserScan& scan, std::size_t step) {
+  if (step <= 1) return scan;
+  core::LaserScan out = scan;
+  out.ranges.clear();
+  for (std::size_t i = 0; i < scan.ranges.size(); i += step) out.ranges.push_back(scan.ranges[i]);
+  out.angle_increment = scan.angle_increment * static_cast<double>(step);
+  out.angle_max = out.angle_min +
+                  out.angle_increment * static_cast<double>(out.ranges.empty() ? 0 : out.ranges.size() - 1);
+  return out;
+}
+
 }  // namespace vision
 }  // namespace picker_localisation

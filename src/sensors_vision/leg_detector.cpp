@@ -1,6 +1,7 @@
 #include "picker_localisation/sensors_vision/leg_detector.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <tuple>
 
@@ -11,6 +12,13 @@ bool isLegCandidate(const ScanCluster& cluster, const LegDetectorOptions& option
   if (cluster.points.empty()) return false;
   return cluster.centroid().norm() <= options.max_leg_range &&
          (cluster.points.back() - cluster.points.front()).norm() <= options.max_leg_width;
+}
+
+double thresholdFor(const LegDetectorOptions& options, double angle_increment) {
+  const double increment = std::abs(angle_increment);
+  if (!(options.threshold_reference_increment > 0.0) || !(increment > options.threshold_reference_increment))
+    return options.leg_threshold;
+  return options.leg_threshold * options.threshold_reference_increment / increment;
 }
 
 std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOptions& options) {
@@ -47,7 +55,8 @@ std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOpti
 
 LegDetector::LegDetector(std::shared_ptr<const LegClassifier> classifier, LegDetectorOptions options)
     : classifier_(std::move(classifier)), options_(options) {
-  if (!classifier_ || !classifier_->trained()) throw std::invalid_argument("LegDetector: needs a trained classifier");
+  if (!classifier_ || !classifier_->trained())
+    throw std::invalid_argument("LegDetector: needs a trained classifier");
 }
 
 LegDetection LegDetector::detect(const core::LaserScan& scan) const {
@@ -62,8 +71,9 @@ LegDetection LegDetector::detect(const core::LaserScan& scan) const {
     candidates.push_back(i);
   }
   const auto prob = classifier_->legProbability(features);
+  const double threshold = thresholdFor(options_, scan.angle_increment);
   for (std::size_t k = 0; k < candidates.size(); ++k) {
-    if (prob[k] < options_.leg_threshold) continue;
+    if (prob[k] < threshold) continue;
     Leg leg;
     leg.position = out.clusters[candidates[k]].centroid();
     leg.confidence = prob[k];

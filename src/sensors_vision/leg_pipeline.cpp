@@ -14,20 +14,44 @@ namespace {
 
 // Keys the leg_detector node reads itself (topics, frames, model, timeouts): valid here, not used here.
 const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {
-      "scan_topics",          "cloud_topic",        "detections_topic", "camera_info_topic", "model_file",
-      "fixed_frame",          "robot_id",           "tf_timeout",       "map_file",          "map_timeout",
-      "publish_observations", "observations_topic", "fusion_max_age",   "map_topic", "max_future_stamp",
-      "max_beams"};
+  static const std::vector<std::string> keys = {"scan_topics",
+                                                "cloud_topic",
+                                                "detections_topic",
+                                                "camera_info_topic",
+                                                "model_file",
+                                                "fixed_frame",
+                                                "robot_id",
+                                                "tf_timeout",
+                                                "map_file",
+                                                "map_timeout",
+                                                "publish_observations",
+                                                "observations_topic",
+                                                "fusion_max_age",
+                                                "map_topic",
+                                                "max_future_stamp",
+                                                "max_beams"};
   return keys;
 }
 const std::vector<std::string>& pipelineKeys() {
-  static const std::vector<std::string> keys = {
-      "leg_threshold",    "max_leg_range",      "max_pair_distance", "single_leg_people",
-      "jump_distance",    "min_cluster_points", "gate_distance",     "hits_to_confirm",
-      "misses_to_delete", "tentative_misses",   "promote_after",     "demote_after",
-      "camera_weight",    "position_sigma",     "require_confirmed", "max_fusion_cluster_width",
-      "cone_half_width",  "camera_fusion"};
+  static const std::vector<std::string> keys = {"leg_threshold",
+                                                "max_leg_range",
+                                                "max_pair_distance",
+                                                "single_leg_people",
+                                                "jump_distance",
+                                                "min_cluster_points",
+                                                "gate_distance",
+                                                "hits_to_confirm",
+                                                "misses_to_delete",
+                                                "tentative_misses",
+                                                "promote_after",
+                                                "demote_after",
+                                                "camera_weight",
+                                                "position_sigma",
+                                                "require_confirmed",
+                                                "max_fusion_cluster_width",
+                                                "cone_half_width",
+                                                "camera_fusion",
+                                                "threshold_reference_increment"};
   return keys;
 }
 
@@ -47,6 +71,7 @@ LegPipelineOptions LegPipelineOptions::fromYaml(const YAML::Node& y, std::vector
   LegPipelineOptions o;
   if (!y || !y.IsMap()) return o;
   read(y, "leg_threshold", o.detector.leg_threshold);
+  read(y, "threshold_reference_increment", o.detector.threshold_reference_increment);
   read(y, "max_leg_range", o.detector.max_leg_range);
   read(y, "max_pair_distance", o.detector.max_pair_distance);
   read(y, "single_leg_people", o.detector.single_leg_people);
@@ -106,6 +131,9 @@ std::string LegPipelineOptions::validate() const {
   const auto& d = detector;
   if (!(d.leg_threshold >= 0.0 && d.leg_threshold <= 1.0))
     return bad("leg_threshold", d.leg_threshold, "in [0, 1]");
+  if (!(d.threshold_reference_increment >= 0.0 && d.threshold_reference_increment < 0.5))
+    return bad("threshold_reference_increment", d.threshold_reference_increment,
+               "in [0, 0.5) rad (0: no scaling)");
   if (!(d.max_leg_range > 0.0)) return bad("max_leg_range", d.max_leg_range, "> 0");
   if (!(d.max_pair_distance > 0.0)) return bad("max_pair_distance", d.max_pair_distance, "> 0");
   if (!(d.segmentation.jump_distance > 0.0)) return bad("jump_distance", d.segmentation.jump_distance, "> 0");

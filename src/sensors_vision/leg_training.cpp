@@ -7,8 +7,9 @@
 
 namespace picker_localisation {
 namespace vision {
-void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
-                            const LegDetectorOptions& options, double match_distance, double unlabelled_negative_distance,
+void collectTrainingSamples(const std::vector<LabelledScan>& positives,
+                            const std::vector<core::LaserScan>& negatives, const LegDetectorOptions& options,
+                            double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels) {
   for (const auto& ls : positives) {
     for (const auto& c : segmentScan(ls.scan, options.segmentation)) {
@@ -34,7 +35,8 @@ void collectTrainingSamples(const std::vector<LabelledScan>& positives, const st
     }
 }
 
-LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans, double hit_distance) {
+LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans,
+                           double hit_distance) {
   LegEvaluation e;
   for (const auto& ls : scans) {
     const auto det = detector.detect(ls.scan);
@@ -59,6 +61,21 @@ LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<c
     e.detections += detector.detect(scan).legs.size();
   }
   return e;
+}
+
+std::vector<LegCurvePoint> legCurve(std::shared_ptr<const LegClassifier> classifier,
+                                    LegDetectorOptions options, const std::vector<LabelledScan>& labelled,
+                                    const std::vector<core::LaserScan>& negatives,
+                                    const std::vector<core::LaserScan>& other,
+                                    const std::vector<double>& thresholds, double hit_distance) {
+  std::vector<LegCurvePoint> curve;
+  for (double threshold : thresholds) {
+    options.leg_threshold = threshold;
+    const LegDetector detector(classifier, options);
+    curve.push_back({threshold, evaluateLegs(detector, labelled, hit_distance),
+                     evaluateNegatives(detector, negatives), evaluateNegatives(detector, other)});
+  }
+  return curve;
 }
 
 }  // namespace vision

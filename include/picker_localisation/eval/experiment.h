@@ -58,7 +58,7 @@ struct RunConfig {
   std::string nbs_config;          // planner of estimated_node / nbs, config/nbs.yaml
   std::string vision_config;       // leg_detector section (vision::LegPipelineOptions, as the node): "" =
                                   // config/vision.yaml, then the simulated-laser overlay config/vision_sim.yaml
-                                  // (leg_threshold 0.3); else comma-separated files applied in order
+                                  // (leg_threshold 0.42 = 0.3 at 0.5 deg); else comma-separated files applied in order
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
 };
 

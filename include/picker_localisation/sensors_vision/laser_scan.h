@@ -19,16 +19,20 @@ struct ScanCluster {
 };
 
 struct SegmentationOptions {
-  double jump_distance = 0.13;     // d_c: consecutive points farther apart than this start a new cluster, m
-  std::size_t min_points = 3;      // m_c: clusters with fewer points are dropped (Algorithm 3 "richness")
-  std::size_t max_points = 200;    // clusters with more points are walls, not legs/people: dropped
-  bool break_on_invalid = true;    // an invalid beam (no return) ends the current cluster
+  double jump_distance = 0.13;   // d_c: consecutive points farther apart than this start a new cluster, m
+  std::size_t min_points = 3;    // m_c: clusters with fewer points are dropped (Algorithm 3 "richness")
+  std::size_t max_points = 200;  // clusters with more points are walls, not legs/people: dropped
+  bool break_on_invalid = true;  // an invalid beam (no return) ends the current cluster
 };
 
 // Algorithm 3: walk the beams in order, start a new cluster when ||p_i - p_{i-1}|| >= d_c (or an invalid beam
 // intervenes), keep clusters with min_points <= size <= max_points. Choice (not in the thesis): a scan that
 // covers a full circle is not wrapped around; the first and last beams belong to different clusters.
 std::vector<ScanCluster> segmentScan(const core::LaserScan& scan, const SegmentationOptions& options = {});
+
+// Every `step`-th beam of a scan (angle_increment x step): the same recording as a coarser laser would see
+// it, for measuring how the leg detector transfers across angular resolutions. step 0 or 1 returns the scan.
+core::LaserScan decimateScan(const core::LaserScan& scan, std::size_t step);
 
 }  // namespace vision
 }  // namespace picker_localisation

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 #include "picker_localisation/sensors_vision/leg_detector.h"
@@ -16,14 +17,14 @@ struct LabelledScan {
   std::vector<Eigen::Vector2d> legs;  // labelled leg positions, scan frame, m
 };
 
-// Clusters of labelled scans whose centroid lies within `match_distance` of a label are positives; clusters of
-// those scans farther than `unlabelled_negative_distance` (> 0) from every label are negatives (the background of
-// the positive recordings; the labelling tool marked the legs of the person in view), the rest are skipped.
-// Every cluster of the negative scans is a negative. Clusters failing the detector's range/width gates are skipped, as the detector never classifies
-// them.
-void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
-                            const LegDetectorOptions& options, double match_distance,
-                            double unlabelled_negative_distance,
+// Clusters of labelled scans whose centroid lies within `match_distance` of a label are positives; clusters
+// of those scans farther than `unlabelled_negative_distance` (> 0) from every label are negatives (the
+// background of the positive recordings; the labelling tool marked the legs of the person in view), the rest
+// are skipped. Every cluster of the negative scans is a negative. Clusters failing the detector's range/width
+// gates are skipped, as the detector never classifies them.
+void collectTrainingSamples(const std::vector<LabelledScan>& positives,
+                            const std::vector<core::LaserScan>& negatives, const LegDetectorOptions& options,
+                            double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels);
 
 struct LegEvaluation {
@@ -35,9 +36,27 @@ struct LegEvaluation {
 };
 
 // Leg detections vs labels, matched one-to-one (Munkres on distance, pairs beyond hit_distance rejected).
-LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans, double hit_distance);
+LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans,
+                           double hit_distance);
 // Scans with no people: every leg detected is false.
 LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<core::LaserScan>& scans);
+
+// One point of a recall vs false-legs-per-scan curve: the detector at `threshold` on labelled scans (recall,
+// precision) and on scans without people (false legs per scan); `other` counts legs per scan on unlabelled
+// scans (e.g. another robot's lasers: an upper bound on its false legs when nobody walks there).
+struct LegCurvePoint {
+  double threshold = 0.0;
+  LegEvaluation labelled;
+  LegEvaluation negatives;
+  LegEvaluation other;
+};
+
+// The curve of one detector setting over `thresholds` (`options.leg_threshold` is replaced at each point).
+std::vector<LegCurvePoint> legCurve(std::shared_ptr<const LegClassifier> classifier,
+                                    LegDetectorOptions options, const std::vector<LabelledScan>& labelled,
+                                    const std::vector<core::LaserScan>& negatives,
+                                    const std::vector<core::LaserScan>& other,
+                                    const std::vector<double>& thresholds, double hit_distance);
 
 }  // namespace vision
 }  // namespace picker_localisation
