@@ -83,7 +83,10 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
       EXPECT_LT(lo, 1.0);
     }
   }
-  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2"; }, 5.0)) << c.diag["dropped: no tf"];
+  // Wait for a 1 Hz status taken after the last bad read (the backwards one), not one from before it.
+  ASSERT_TRUE(ranging_test::waitFor(
+      [&] { return c.diag["dropped: no tf"] == "2" && c.diag["rejected: out of order"] == "1"; }, 5.0))
+      << c.diag["dropped: no tf"] << " / " << c.diag["rejected: out of order"];
   EXPECT_EQ(c.diag["rejected: unknown tag"], "1");
   EXPECT_EQ(c.diag["rejected: out of order"], "1");
   EXPECT_EQ(c.diag["rejected: not finite"], "1");

@@ -102,7 +102,11 @@ TEST(UwbRangingNode, BadRangesAreDroppedAndGoodOnesStillPublish) {
     EXPECT_NEAR(o.position.x, picker.x(), 0.15);
     EXPECT_NEAR(o.position.y, picker.y(), 0.15);
   }
-  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2"; }, 5.0)) << c.diag["dropped: no tf"];
+  // The drops without tf happen first, so a 1 Hz status published between the two observations already shows
+  // them with one RHF update: wait for a status taken after the second update (this raced once in a clean clone).
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["dropped: no tf"] == "2" && c.diag["RHF updates"] == "2"; },
+                                    5.0))
+      << c.diag["dropped: no tf"] << " / " << c.diag["RHF updates"];
   EXPECT_EQ(c.diag["rejected: unknown tag"], "1");
   EXPECT_EQ(c.diag["rejected: not finite"], "1");
   EXPECT_EQ(c.diag["rejected: negative range"], "1");
