@@ -55,8 +55,7 @@ std::vector<Person> pairLegs(const std::vector<Leg>& legs, const LegDetectorOpti
 
 LegDetector::LegDetector(std::shared_ptr<const LegClassifier> classifier, LegDetectorOptions options)
     : classifier_(std::move(classifier)), options_(options) {
-  if (!classifier_ || !classifier_->trained())
-    throw std::invalid_argument("LegDetector: needs a trained classifier");
+  if (!classifier_ || !classifier_->trained()) throw std::invalid_argument("LegDetector: needs a trained classifier");
 }
 
 LegDetection LegDetector::detect(const core::LaserScan& scan) const {

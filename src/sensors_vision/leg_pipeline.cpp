@@ -14,44 +14,20 @@ namespace {
 
 // Keys the leg_detector node reads itself (topics, frames, model, timeouts): valid here, not used here.
 const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {"scan_topics",
-                                                "cloud_topic",
-                                                "detections_topic",
-                                                "camera_info_topic",
-                                                "model_file",
-                                                "fixed_frame",
-                                                "robot_id",
-                                                "tf_timeout",
-                                                "map_file",
-                                                "map_timeout",
-                                                "publish_observations",
-                                                "observations_topic",
-                                                "fusion_max_age",
-                                                "map_topic",
-                                                "max_future_stamp",
-                                                "max_beams"};
+  static const std::vector<std::string> keys = {
+      "scan_topics",          "cloud_topic",        "detections_topic", "camera_info_topic", "model_file",
+      "fixed_frame",          "robot_id",           "tf_timeout",       "map_file",          "map_timeout",
+      "publish_observations", "observations_topic", "fusion_max_age",   "map_topic", "max_future_stamp",
+      "max_beams"};
   return keys;
 }
 const std::vector<std::string>& pipelineKeys() {
-  static const std::vector<std::string> keys = {"leg_threshold",
-                                                "max_leg_range",
-                                                "max_pair_distance",
-                                                "single_leg_people",
-                                                "jump_distance",
-                                                "min_cluster_points",
-                                                "gate_distance",
-                                                "hits_to_confirm",
-                                                "misses_to_delete",
-                                                "tentative_misses",
-                                                "promote_after",
-                                                "demote_after",
-                                                "camera_weight",
-                                                "position_sigma",
-                                                "require_confirmed",
-                                                "max_fusion_cluster_width",
-                                                "cone_half_width",
-                                                "camera_fusion",
-                                                "threshold_reference_increment"};
+  static const std::vector<std::string> keys = {
+      "leg_threshold",    "max_leg_range",      "max_pair_distance", "single_leg_people",
+      "jump_distance",    "min_cluster_points", "gate_distance",     "hits_to_confirm",
+      "misses_to_delete", "tentative_misses",   "promote_after",     "demote_after",
+      "camera_weight",    "position_sigma",     "require_confirmed", "max_fusion_cluster_width",
+      "cone_half_width",  "camera_fusion",      "threshold_reference_increment"};
   return keys;
 }
 

@@ -7,9 +7,8 @@
 
 namespace picker_localisation {
 namespace vision {
-void collectTrainingSamples(const std::vector<LabelledScan>& positives,
-                            const std::vector<core::LaserScan>& negatives, const LegDetectorOptions& options,
-                            double match_distance, double unlabelled_negative_distance,
+void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
+                            const LegDetectorOptions& options, double match_distance, double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels) {
   for (const auto& ls : positives) {
     for (const auto& c : segmentScan(ls.scan, options.segmentation)) {
@@ -35,8 +34,7 @@ void collectTrainingSamples(const std::vector<LabelledScan>& positives,
     }
 }
 
-LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans,
-                           double hit_distance) {
+LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans, double hit_distance) {
   LegEvaluation e;
   for (const auto& ls : scans) {
     const auto det = detector.detect(ls.scan);

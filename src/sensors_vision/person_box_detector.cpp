@@ -43,11 +43,11 @@ struct HogPersonDetector::Impl {
 };
 
 const std::vector<std::string>& CameraDetectorOptions::yamlKeys() {
-  static const std::vector<std::string> keys{"onnx_model",        "hog_model",        "resize",           "hit_threshold",
-                                             "min_confidence",    "scale",            "onnx_input_width",
-                                             "onnx_input_height", "onnx_person_class", "max_rate",
-                                             "max_age",           "max_future_stamp", "horizontal_fov",
-                                             "bearing_frame",     "robot_id"};
+  static const std::vector<std::string> keys{"onnx_model",       "hog_model",         "resize",
+                                             "hit_threshold",    "min_confidence",    "scale",
+                                             "onnx_input_width", "onnx_input_height", "onnx_person_class",
+                                             "max_rate",         "max_age",           "max_future_stamp",
+                                             "horizontal_fov",   "bearing_frame",     "robot_id"};
   return keys;
 }
 
@@ -81,8 +81,7 @@ CameraDetectorOptions CameraDetectorOptions::fromYamlFile(const std::string& pat
 
 std::string CameraDetectorOptions::validate() const {
   const auto bad = core::badValue;
-  const auto& models = HogOptions::models();
-  if (std::find(models.begin(), models.end(), hog.model) == models.end())
+  if (hog.model != "default" && hog.model != "daimler")
     return "hog_model = " + hog.model + ": must be default or daimler";
   if (!(hog.resize > 0.0 && hog.resize <= 4.0)) return bad("resize", hog.resize, "in (0, 4]");
   if (!(hog.scale > 1.0 && hog.scale <= 2.0)) return bad("scale", hog.scale, "in (1, 2]");
@@ -101,11 +100,6 @@ std::string CameraDetectorOptions::validate() const {
 std::unique_ptr<PersonBoxDetector> CameraDetectorOptions::makeDetector() const {
   if (onnx_model.empty()) return std::make_unique<HogPersonDetector>(hog);
   return std::make_unique<OnnxPersonDetector>(onnx);
-}
-
-const std::vector<std::string>& HogOptions::models() {
-  static const std::vector<std::string> names{"default", "daimler"};
-  return names;
 }
 
 HogPersonDetector::HogPersonDetector(HogOptions options) : options_(options), impl_(std::make_shared<Impl>()) {

@@ -1,12 +1,11 @@
 // Offline leg detection on recorded bags.
-//   bag_detect_legs --bag FILE --topic TOPIC --out FILE.csv [--model M] [--threshold P] [--min-cluster-points
-//   N]
+//   bag_detect_legs --bag FILE --topic TOPIC --out FILE.csv [--model M] [--threshold P]
+//                   [--min-cluster-points N] [--jump-distance D] [--max-leg-range R]
 // CSV: stamp,x,y,confidence, one row per detected leg (stamp: the scan's header stamp, s; x, y: the scan's
 // own frame, m; confidence: the classifier's leg probability).
 //   bag_detect_legs --curve --labelled BAG [--labelled BAG ...] [--negatives BAG [--negatives-from F]]
 //                   [--other BAG ...] [--model M] [--min-cluster-points N] [--jump-distance D]
-//                   [--max-leg-range R]
-//                   [--decimate K] [--sweep]
+//                   [--max-leg-range R] [--decimate K] [--sweep]
 // prints the recall vs false-legs-per-scan curve (thresholds 0.2 .. 0.8) of the detector setting:
 //   --labelled: leg_tracker "positive_N_extracted" bags (/training_scan + /leg_cluster_positions): recall and
 //               precision, a detection within 0.15 m of a label is a hit (one-to-one);

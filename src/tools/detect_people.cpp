@@ -1,16 +1,14 @@
 // Offline person boxes on a video or a folder of images:
-//   detect_people --video FILE | --images DIR --out FILE.csv [--model default|daimler] [--resize F] [--scale
-//   S]
-//                 [--hit-threshold T] [--min-confidence C] [--onnx MODEL.onnx] [--max-frames N]
+//   detect_people --video FILE | --images DIR --out FILE.csv [--model default|daimler] [--resize F]
+//                 [--scale S] [--hit-threshold T] [--min-confidence C] [--onnx MODEL.onnx] [--max-frames N]
 // CSV: frame,x,y,width,height,confidence (frame: the image's file name, or the video frame index; x, y:
 // top-left corner in pixels of the original image). HOG people detector (config/vision.yaml's camera_detector
-// defaults) unless --onnx is given. Scored against hand labels (frame,x1,y1,x2,y2,person|ignore; e.g.
-// test/data/vtest_people.csv), only the labelled frames are run:
-//   detect_people --video FILE --labels LABELS.csv [options]   -> recall, precision, false boxes and ms per
-//   frame detect_people --video FILE --labels LABELS.csv --sweep     -> that table for every HOG option set
-//   below, each
-//                 row at several confidence cuts, the cost relative to one native default-HOG pass in the
-//                 same run
+// defaults) unless --onnx is given.
+// Scored against hand labels (frame,x1,y1,x2,y2,person|ignore; e.g. test/data/vtest_people.csv), only the
+// labelled frames are run:
+//   detect_people --video FILE --labels LABELS.csv [options]  -> recall, precision, false boxes, ms per frame
+//   detect_people --video FILE --labels LABELS.csv --sweep    -> that table for every HOG option set below,
+//                 each at several confidence cuts, the cost relative to one native default-HOG pass (same run)
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -114,10 +112,6 @@ const char* kTableHeader =
 
 int sweep(const std::vector<Frame>& frames,
           const std::map<std::string, std::vector<LabelledPerson>>& labels) {
-  struct Setting {
-    std::string name;
-    HogOptions options;
-  };
   auto make = [](const std::string& model, double resize, double scale, double hit) {
     HogOptions o;
     o.model = model;
@@ -125,10 +119,10 @@ int sweep(const std::vector<Frame>& frames,
     o.scale = scale;
     o.hit_threshold = hit;
     o.min_confidence = 0.0;  // cut afterwards
-    return Setting{describe(o), o};
+    return o;
   };
   // The first row is the cost baseline (one native pass of OpenCV's default people detector).
-  const std::vector<Setting> settings{
+  const std::vector<HogOptions> settings{
       make("default", 1.0, 1.05, 0.0),  make("daimler", 1.0, 1.05, 0.0),  make("default", 1.5, 1.05, 0.0),
       make("default", 2.0, 1.05, 0.0),  make("daimler", 1.25, 1.08, 0.0), make("daimler", 1.5, 1.10, 0.0),
       make("default", 1.5, 1.10, 0.0),  make("default", 1.5, 1.10, -0.1), make("default", 1.5, 1.10, -0.2),
@@ -137,17 +131,20 @@ int sweep(const std::vector<Frame>& frames,
   std::printf("%zu frames\n%s", frames.size(), kTableHeader);
   double baseline_ms = 0.0;
   for (const auto& setting : settings) {
-    HogPersonDetector detector(setting.options);
+    const HogPersonDetector detector(setting);
     const auto scores = score(detector, frames, labels, cuts);
     if (baseline_ms == 0.0) baseline_ms = scores.front().msPerFrame();
-    for (std::size_t c = 0; c < cuts.size(); ++c) printRow(setting.name, cuts[c], scores[c], baseline_ms);
+    for (std::size_t c = 0; c < cuts.size(); ++c) printRow(describe(setting), cuts[c], scores[c], baseline_ms);
   }
   return 0;
 }
 
-std::unique_ptr<PersonBoxDetector> makeDetector(const HogOptions& hog, const std::string& onnx) {
-  if (onnx.empty()) return std::make_unique<HogPersonDetector>(hog);
-  return std::make_unique<OnnxPersonDetector>(OnnxOptions{onnx});
+// The detector the node would build from these options (camera_detector's schema decides HOG or ONNX).
+CameraDetectorOptions cameraOptions(const HogOptions& hog, const std::string& onnx) {
+  CameraDetectorOptions camera;
+  camera.hog = hog;
+  camera.onnx_model = camera.onnx.model_path = onnx;
+  return camera;
 }
 
 }  // namespace
@@ -213,14 +210,15 @@ int main(int argc, char** argv) {
       });
       if (frames.empty()) throw std::runtime_error("no labelled frame found in the input");
       if (do_sweep) return sweep(frames, labels);
-      const auto detector = makeDetector(hog, onnx);
+      const CameraDetectorOptions camera = cameraOptions(hog, onnx);
       const double cut = 0.0;  // the detector applies its own min_confidence
-      const auto s = score(*detector, frames, labels, {cut}).front();
+      const auto s = score(*camera.makeDetector(), frames, labels, {cut}).front();
       std::printf("%zu frames\n%s", frames.size(), kTableHeader);
-      printRow(onnx.empty() ? describe(hog) : onnx, onnx.empty() ? hog.min_confidence : 0.5, s, 0.0);
+      printRow(onnx.empty() ? describe(hog) : onnx, onnx.empty() ? hog.min_confidence : camera.onnx.min_confidence,
+               s, 0.0);
       return 0;
     }
-    const auto detector = makeDetector(hog, onnx);
+    const auto detector = cameraOptions(hog, onnx).makeDetector();
     std::ofstream csv(out);
     if (!csv) throw std::runtime_error("cannot write " + out);
     csv << "frame,x,y,width,height,confidence\n";

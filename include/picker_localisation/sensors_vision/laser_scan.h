@@ -19,10 +19,10 @@ struct ScanCluster {
 };
 
 struct SegmentationOptions {
-  double jump_distance = 0.13;   // d_c: consecutive points farther apart than this start a new cluster, m
-  std::size_t min_points = 3;    // m_c: clusters with fewer points are dropped (Algorithm 3 "richness")
-  std::size_t max_points = 200;  // clusters with more points are walls, not legs/people: dropped
-  bool break_on_invalid = true;  // an invalid beam (no return) ends the current cluster
+  double jump_distance = 0.13;     // d_c: consecutive points farther apart than this start a new cluster, m
+  std::size_t min_points = 3;      // m_c: clusters with fewer points are dropped (Algorithm 3 "richness")
+  std::size_t max_points = 200;    // clusters with more points are walls, not legs/people: dropped
+  bool break_on_invalid = true;    // an invalid beam (no return) ends the current cluster
 };
 
 // Algorithm 3: walk the beams in order, start a new cluster when ||p_i - p_{i-1}|| >= d_c (or an invalid beam

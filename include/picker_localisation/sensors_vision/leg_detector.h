@@ -15,14 +15,14 @@ namespace vision {
 
 struct Leg {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // cluster centroid, m, scan frame
-  double confidence = 0.0;                             // classifier leg probability
-  std::size_t cluster_index = 0;                       // index into LegDetection::clusters
+  double confidence = 0.0;                              // classifier leg probability
+  std::size_t cluster_index = 0;                        // index into LegDetection::clusters
 };
 
 struct Person {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();  // m, frame of the legs
-  double confidence = 0.0;                             // [0, 1]
-  int leg_a = -1, leg_b = -1;                          // indices into the legs; leg_b == -1 for a single leg
+  double confidence = 0.0;                              // [0, 1]
+  int leg_a = -1, leg_b = -1;                           // indices into the legs; leg_b == -1 for a single leg
 };
 
 struct LegDetection {
@@ -34,16 +34,16 @@ struct LegDetection {
 
 struct LegDetectorOptions {
   SegmentationOptions segmentation;
-  double leg_threshold = 0.6;  // minimum leg probability for a cluster to be a leg, at the angular
-                               // resolution of the training lasers (see thresholdFor)
+  double leg_threshold = 0.6;          // minimum leg probability for a cluster to be a leg, at the angular
+                                       // resolution of the training lasers (see thresholdFor)
   double threshold_reference_increment = 0.006136;  // rad (0.3516 deg), the training lasers' beam spacing; a
                                                     // coarser laser's threshold is scaled down by the ratio
                                                     // (0: no scaling)
-  double max_leg_range = 8.0;                       // clusters farther from the sensor are ignored, m
-  double max_leg_width = 0.5;                       // clusters wider than this are never legs, m
-  double max_pair_distance = 0.7;                   // two legs closer than this may be one person, m
-  bool single_leg_people = true;                    // an unpaired leg is a person (other leg occluded) ...
-  double single_leg_factor = 0.5;                   // ... with its confidence scaled by this factor
+  double max_leg_range = 8.0;          // clusters farther from the sensor are ignored, m
+  double max_leg_width = 0.5;          // clusters wider than this are never legs, m
+  double max_pair_distance = 0.7;      // two legs closer than this may be one person, m
+  bool single_leg_people = true;       // an unpaired leg is a person (other leg occluded) ...
+  double single_leg_factor = 0.5;      // ... with its confidence scaled by this factor
 };
 
 // Range and width gates applied before classification: clusters outside them are never legs.

@@ -17,14 +17,14 @@ struct LabelledScan {
   std::vector<Eigen::Vector2d> legs;  // labelled leg positions, scan frame, m
 };
 
-// Clusters of labelled scans whose centroid lies within `match_distance` of a label are positives; clusters
-// of those scans farther than `unlabelled_negative_distance` (> 0) from every label are negatives (the
-// background of the positive recordings; the labelling tool marked the legs of the person in view), the rest
-// are skipped. Every cluster of the negative scans is a negative. Clusters failing the detector's range/width
-// gates are skipped, as the detector never classifies them.
-void collectTrainingSamples(const std::vector<LabelledScan>& positives,
-                            const std::vector<core::LaserScan>& negatives, const LegDetectorOptions& options,
-                            double match_distance, double unlabelled_negative_distance,
+// Clusters of labelled scans whose centroid lies within `match_distance` of a label are positives; clusters of
+// those scans farther than `unlabelled_negative_distance` (> 0) from every label are negatives (the background of
+// the positive recordings; the labelling tool marked the legs of the person in view), the rest are skipped.
+// Every cluster of the negative scans is a negative. Clusters failing the detector's range/width gates are skipped, as the detector never classifies
+// them.
+void collectTrainingSamples(const std::vector<LabelledScan>& positives, const std::vector<core::LaserScan>& negatives,
+                            const LegDetectorOptions& options, double match_distance,
+                            double unlabelled_negative_distance,
                             std::vector<LegFeatures>& samples, std::vector<int>& labels);
 
 struct LegEvaluation {
@@ -36,8 +36,7 @@ struct LegEvaluation {
 };
 
 // Leg detections vs labels, matched one-to-one (Munkres on distance, pairs beyond hit_distance rejected).
-LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans,
-                           double hit_distance);
+LegEvaluation evaluateLegs(const LegDetector& detector, const std::vector<LabelledScan>& scans, double hit_distance);
 // Scans with no people: every leg detected is false.
 LegEvaluation evaluateNegatives(const LegDetector& detector, const std::vector<core::LaserScan>& scans);
 

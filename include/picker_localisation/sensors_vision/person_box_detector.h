@@ -38,8 +38,6 @@ struct HogOptions {
   double min_confidence = 0.5;    // boxes below this confidence are dropped
   double nms_iou = 0.4;           // non-maximum suppression overlap
   double confidence_scale = 1.0;  // confidence = 1 - exp(-weight / scale) for the SVM weight
-
-  static const std::vector<std::string>& models();  // the accepted values of `model`
 };
 
 // cv::HOGDescriptor with OpenCV's built-in people SVM named by HogOptions::model (no weights to download). The
