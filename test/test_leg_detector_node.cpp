@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -123,7 +124,7 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
     EXPECT_TRUE(std::isfinite(o.position.x));
   }
 
-  // An empty scan (no returns) and a scan in a frame without tf: no output, no crash.
+  // A scan with no return at all (+inf: free space) and a scan in a frame without tf: no people, no crash.
   const std::size_t before = rec.people.size();
   // Scan `i` of the bag, restamped, in `frame`, changed by `edit`.
   auto sendScan = [&](std::size_t i, const std::string& frame, const ros::Time& stamp,
@@ -145,7 +146,22 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
   sendScan(3, "", ros::Time::now());
   sendScan(4, "right_laser", ros::Time::now(), [](sensor_msgs::LaserScan& s) { s.ranges.assign(1000000, 3.0f); });
   waitFor([] { return false; }, 0.8);
-  EXPECT_EQ(rec.people.size(), before);
+  ASSERT_EQ(rec.people.size(), before + 1);  // the free-space scan is processed: one message, nobody in it
+  EXPECT_TRUE(rec.people.back().detections.empty());
+  // The scan of +inf beams saw free space (REP 117): no person, but one negative observation ("nobody at
+  // these nodes"): anonymous, no position, every map node listed, some of them below 1. The real scans before
+  // it (a room: walls hide every node's place) gave none.
+  std::size_t negatives = 0;
+  for (const auto& o : rec.observations) {
+    if (!std::isnan(o.position.x)) continue;
+    ++negatives;
+    EXPECT_FALSE(o.identifying);
+    EXPECT_EQ(o.nodes.size(), 138u);
+    ASSERT_EQ(o.likelihood.size(), o.nodes.size());
+    EXPECT_LT(*std::min_element(o.likelihood.begin(), o.likelihood.end()), 1.0);
+    EXPECT_DOUBLE_EQ(*std::max_element(o.likelihood.begin(), o.likelihood.end()), 1.0);
+  }
+  EXPECT_EQ(negatives, 1u);
   std::map<std::string, std::string> diag;
   auto diag_sub = followDiagnostics(nh, diag);
   ASSERT_TRUE(waitFor([&] { return diag["scans over max_beams (dropped)"] == "1"; }, 5.0))

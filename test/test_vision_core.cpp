@@ -13,6 +13,7 @@
 #include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
 #include "picker_localisation/sensors_vision/munkres.h"
 #include "picker_localisation/sensors_vision/person_box_detector.h"
+#include "picker_localisation/topology/synthetic_map.h"
 
 using namespace picker_localisation;
 using namespace picker_localisation::vision;
@@ -277,6 +278,96 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
   EXPECT_NE(unknown[0].find("'leg_threshold'"), std::string::npos) << unknown[0];
   for (const char* bad : {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}",
                           "{hits_to_confirm: 0}", "{leg_threshold: abc}"}) {
+    try {
+      LegPipelineOptions::fromYaml(YAML::Load(bad));
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::runtime_error& e) {
+      const std::string key = std::string(bad).substr(1, std::string(bad).find(':') - 1);
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Negative information: a laser that sees through a node's place and finds nobody lowers that node's
+// likelihood by the detection probability at its range; out of view, occluded or near a person it does not.
+TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes) {
+  topology::PolytunnelSpec spec;
+  spec.lanes = 4;
+  spec.nodes_per_lane = 10;  // lane k at x = 1.5 k, nodes every 3 m along +y from y = 0
+  const topology::TopologicalMap map = topology::makePolytunnelMap(spec);
+  LegPipelineOptions o;  // defaults: p_detect 0.5 within 3 m, 0 from 5 m, period 2 s, clearance 1.5 m
+  auto classifier = std::make_shared<LegClassifier>();
+  classifier->load(std::string(PL_PACKAGE_DIR) + "/config/leg_classifier.yml");
+  LegPipeline pipeline(classifier, o);
+  // A laser at (0.75, 10.5), between lanes 0 and 1, looking along +y, 270 deg, nothing within range_max (+inf).
+  const Eigen::Isometry3d laser =
+      Eigen::Translation3d(0.75, 10.5, 0.0) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  core::LaserScan scan;
+  scan.angle_min = -2.356194;
+  scan.angle_max = 2.356194;
+  scan.angle_increment = 0.00872665;
+  scan.range_min = 0.1;
+  scan.range_max = 30.0;
+  scan.ranges.assign(541, std::numeric_limits<float>::infinity());
+  auto at = [&](const core::Observation& obs, const char* name) {
+    const topology::NodeIndex n = *map.index(name);
+    return obs.likelihood[n];
+  };
+  const auto obs = pipeline.negativeObservation("laser", 100.0, scan, laser, {}, map, "robot_1");
+  ASSERT_TRUE(obs.has_value());
+  EXPECT_FALSE(obs->identifying);
+  EXPECT_EQ(obs->sensor, "lidar");
+  EXPECT_EQ(obs->robot_id, "robot_1");
+  EXPECT_FALSE(obs->position.has_value());
+  ASSERT_EQ(obs->nodes.size(), map.numNodes());  // every node listed: the rest keeps likelihood 1
+  EXPECT_EQ(core::validateObservation(*obs, map), "");
+  EXPECT_DOUBLE_EQ(at(*obs, "r1_4"), 0.5);  // 1.7 m ahead
+  EXPECT_DOUBLE_EQ(at(*obs, "r0_4"), 0.5);  // 1.7 m, the other lane
+  EXPECT_DOUBLE_EQ(at(*obs, "r2_4"), 0.5);  // 2.7 m
+  EXPECT_NEAR(at(*obs, "r1_5"), 1.0 - 0.5 * (5.0 - std::hypot(0.75, 4.5)) / 2.0, 1e-9);  // 4.6 m: tapered
+  EXPECT_DOUBLE_EQ(at(*obs, "r1_3"), 1.0);  // 1.7 m behind: outside the 270 deg field of view
+  EXPECT_DOUBLE_EQ(at(*obs, "r1_9"), 1.0);    // 16.5 m: beyond negative_range_max
+  // At most one per period and frame; another frame has its own period.
+  EXPECT_FALSE(pipeline.negativeObservation("laser", 101.0, scan, laser, {}, map, "robot_1").has_value());
+  EXPECT_TRUE(pipeline.negativeObservation("laser_rear", 101.0, scan, laser, {}, map, "robot_1").has_value());
+  EXPECT_TRUE(pipeline.negativeObservation("laser", 102.0, scan, laser, {}, map, "robot_1").has_value());
+
+  // Someone the classifier did not report stands in r1_4's cell at (1.8, 12.5), 0.6 m from the node and off
+  // the line of sight to it (beams -27.7 deg +- 3 deg return at 2.26 m): the laser cannot see through the
+  // whole cell, which keeps likelihood 1; the other lane's r0_4 is still seen empty.
+  core::LaserScan blocked = scan;
+  for (std::size_t i = 0; i < blocked.ranges.size(); ++i)
+    if (std::abs(blocked.angle(i) - std::atan2(-1.05, 2.0)) < 0.05) blocked.ranges[i] = 2.26f;
+  LegPipeline undetected(classifier, o);
+  const auto person_there = undetected.negativeObservation("laser", 100.0, blocked, laser, {}, map, "robot_1");
+  ASSERT_TRUE(person_there.has_value());
+  EXPECT_DOUBLE_EQ(at(*person_there, "r1_4"), 1.0);
+  EXPECT_DOUBLE_EQ(at(*person_there, "r0_4"), 0.5);
+
+  // A person candidate next to r0_4: that node keeps likelihood 1, r1_4 (1.8 m away) does not.
+  LegPipeline with_person(classifier, o);
+  const std::vector<PersonCandidate> person = {{Eigen::Vector2d(-0.3, 12.0), 0.9, "lidar", true}};
+  const auto near = with_person.negativeObservation("laser", 100.0, scan, laser, person, map, "robot_1");
+  ASSERT_TRUE(near.has_value());
+  EXPECT_DOUBLE_EQ(at(*near, "r0_4"), 1.0);
+  EXPECT_DOUBLE_EQ(at(*near, "r1_4"), 0.5);
+
+  // Something 1 m in front of every beam: the laser sees no node's place, so it says nothing.
+  LegPipeline occluded(classifier, o);
+  core::LaserScan wall = scan;
+  wall.ranges.assign(541, 1.0f);
+  EXPECT_FALSE(occluded.negativeObservation("laser", 100.0, wall, laser, {}, map, "robot_1").has_value());
+  // Beams that return nothing valid (NaN) see nothing either.
+  wall.ranges.assign(541, std::numeric_limits<float>::quiet_NaN());
+  EXPECT_FALSE(occluded.negativeObservation("laser", 100.0, wall, laser, {}, map, "robot_1").has_value());
+
+  // Switched off.
+  o.negative_information = false;
+  LegPipeline off(classifier, o);
+  EXPECT_FALSE(off.negativeObservation("laser", 100.0, scan, laser, {}, map, "robot_1").has_value());
+  // Bad values are refused by name.
+  for (const char* bad : {"{negative_p_detect: 1.0}", "{negative_range_max: 2.0}", "{negative_period: -1}",
+                          "{negative_clearance: -0.5}"}) {
     try {
       LegPipelineOptions::fromYaml(YAML::Load(bad));
       ADD_FAILURE() << bad << " accepted";

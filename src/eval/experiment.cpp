@@ -450,8 +450,12 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         const Eigen::Isometry3d fixed_from_sensor =
             Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
             Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
-        const std::vector<vision::TrackedPerson> tracked =
-            legs->processScan(s.frame_id, s.stamp, s, fixed_from_sensor);
+        const std::vector<vision::PersonCandidate> candidates = legs->scanCandidates(s, fixed_from_sensor);
+        const std::vector<vision::TrackedPerson> tracked = legs->track(s.frame_id, s.stamp, candidates);
+        if (spec.tracker != Tracker::kUkf)  // as leg_detector publishes it: "nobody at these nodes"
+          if (auto neg = legs->negativeObservation(s.frame_id, s.stamp, s, fixed_from_sensor, candidates, *map,
+                                                   s.robot_id))
+            toTracker(*neg);
         result.lidar_detections += tracked.size();
         // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's
         // bias-corrected fix and tracker belief.

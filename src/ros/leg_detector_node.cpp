@@ -5,6 +5,8 @@
 #include <picker_localisation/PersonDetectionArray.h>
 #include <ros/package.h>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "picker_localisation/core/observation.h"
@@ -151,15 +153,27 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   }
   last_input_ = msg->header.stamp;
   const auto scan = toScanData(*msg);
-  if (scan.validCount() == 0) {
+  // REP 117: +inf is a beam that saw nothing within range_max, free space the negative information uses; a scan
+  // with neither a valid return nor such a beam (all NaN, -inf or out of limits) says nothing.
+  const bool sees_free_space = std::any_of(scan.ranges.begin(), scan.ranges.end(),
+                                           [](float r) { return std::isinf(r) && r > 0.0f; });
+  if (scan.validCount() == 0 && !sees_free_space) {
     ++empty_scans_;
-    ROS_WARN_THROTTLE(5.0, "%s: scan on %s has no valid return (empty scan ignored)",
+    ROS_WARN_THROTTLE(5.0, "%s: scan on %s has no valid return and no free beam (ignored)",
                       ros::this_node::getName().c_str(), msg->header.frame_id.c_str());
     return;
   }
   Eigen::Isometry3d tf;
   if (!lookup(fixed_frame_, msg->header.frame_id, msg->header.stamp, tf)) return;
-  publishPeople(msg->header.frame_id, msg->header.stamp, pipeline_->scanCandidates(scan, tf));
+  const std::vector<vision::PersonCandidate> candidates = pipeline_->scanCandidates(scan, tf);
+  publishPeople(msg->header.frame_id, msg->header.stamp, candidates);
+  if (!map_) return;
+  // "Nobody at these nodes" (LegPipeline::negativeObservation), after this scan's people updated the tracks.
+  if (auto negative = pipeline_->negativeObservation(msg->header.frame_id, msg->header.stamp.toSec(), scan, tf,
+                                                     candidates, *map_, robot_id_)) {
+    obs_pub_.publish(toMsg(*negative, *map_, fixed_frame_));
+    ++negative_observations_;
+  }
 }
 
 void LegDetectorNode::cloudCallback(const sensor_msgs::PointCloud2::ConstPtr& msg) {
@@ -282,6 +296,7 @@ void LegDetectorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("people published", people_);
   stat.add("camera-confirmed people", fused_);
   stat.add("observations published", observations_);
+  stat.add("negative observations published", negative_observations_);
   stat.add("live tracks", pipeline_ ? pipeline_->liveTracks() : 0);
   stat.add("last input stamp", last_input_.toSec());
 }

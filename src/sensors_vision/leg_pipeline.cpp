@@ -1,5 +1,6 @@
 #include "picker_localisation/sensors_vision/leg_pipeline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -27,7 +28,9 @@ const std::vector<std::string>& pipelineKeys() {
       "jump_distance",    "min_cluster_points", "gate_distance",     "hits_to_confirm",
       "misses_to_delete", "tentative_misses",   "promote_after",     "demote_after",
       "camera_weight",    "position_sigma",     "require_confirmed", "max_fusion_cluster_width",
-      "cone_half_width",  "camera_fusion",      "threshold_reference_increment"};
+      "cone_half_width",  "camera_fusion",      "threshold_reference_increment",
+      "negative_information", "negative_period", "negative_p_detect", "negative_range_full",
+      "negative_range_max", "negative_clearance"};
   return keys;
 }
 
@@ -69,6 +72,12 @@ LegPipelineOptions LegPipelineOptions::fromYaml(const YAML::Node& y, std::vector
   read(y, "require_confirmed", o.require_confirmed);
   read(y, "max_fusion_cluster_width", o.max_fusion_cluster_width);
   read(y, "cone_half_width", o.cone_half_width);
+  read(y, "negative_information", o.negative_information);
+  read(y, "negative_period", o.negative_period);
+  read(y, "negative_p_detect", o.negative_p_detect);
+  read(y, "negative_range_full", o.negative_range_full);
+  read(y, "negative_range_max", o.negative_range_max);
+  read(y, "negative_clearance", o.negative_clearance);
   // The node enables fusion when a detections topic is set; the key may also be given explicitly.
   if (y["detections_topic"] && y["detections_topic"].IsScalar())
     o.camera_fusion = !y["detections_topic"].as<std::string>().empty();
@@ -126,6 +135,16 @@ std::string LegPipelineOptions::validate() const {
     return bad("max_fusion_cluster_width", max_fusion_cluster_width, "> 0");
   if (!(cone_half_width > 0.0 && cone_half_width < M_PI))
     return bad("cone_half_width", cone_half_width, "in (0, pi)");
+  if (!(negative_period >= 0.0) || !std::isfinite(negative_period))
+    return bad("negative_period", negative_period, "finite and >= 0");
+  if (!(negative_p_detect >= 0.0 && negative_p_detect < 1.0))
+    return bad("negative_p_detect", negative_p_detect, "in [0, 1)");
+  if (!(negative_range_full >= 0.0) || !std::isfinite(negative_range_full))
+    return bad("negative_range_full", negative_range_full, "finite and >= 0");
+  if (!(negative_range_max > negative_range_full) || !std::isfinite(negative_range_max))
+    return bad("negative_range_max", negative_range_max, "finite and > negative_range_full");
+  if (!(negative_clearance >= 0.0) || !std::isfinite(negative_clearance))
+    return bad("negative_clearance", negative_clearance, "finite and >= 0");
   return "";
 }
 
@@ -209,6 +228,100 @@ std::vector<TrackedPerson> LegPipeline::track(const std::string& source_frame, d
     out.push_back(std::move(t));
   }
   return out;
+}
+
+namespace {
+
+// Whether the scan's beams towards `q` (sensor frame) reach at least `margin` beyond it: the nearest valid
+// return of the beam and its two neighbours; a beam with no return within range_max (+inf, REP 117) sees to
+// range_max; an invalid or too-close return (NaN, -inf) sees nothing.
+bool seesThrough(const core::LaserScan& scan, const Eigen::Vector2d& q, double margin) {
+  const double r = q.norm();
+  if (!(r > scan.range_min) || r + margin > scan.range_max || !(scan.angle_increment > 0.0)) return false;
+  const double a = std::atan2(q.y(), q.x());
+  if (a < scan.angle_min || a > scan.angle_max) return false;
+  const long k = std::lround((a - scan.angle_min) / scan.angle_increment);
+  const long last = static_cast<long>(scan.ranges.size()) - 1;
+  if (k < 0 || k > last) return false;
+  for (long i = std::max(0L, k - 1); i <= std::min(last, k + 1); ++i) {
+    const float v = scan.ranges[static_cast<std::size_t>(i)];
+    if (std::isnan(v) || v < 0.0f) return false;  // invalid, or -inf: closer than range_min
+    const double seen = std::isinf(v) || v > scan.range_max ? scan.range_max : static_cast<double>(v);
+    if (seen < r + margin) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<core::Observation> LegPipeline::negativeObservation(
+    const std::string& source_frame, double stamp, const core::LaserScan& scan,
+    const Eigen::Isometry3d& fixed_from_sensor, const std::vector<PersonCandidate>& candidates,
+    const topology::TopologicalMap& map, const std::string& robot_id) {
+  const LegPipelineOptions& o = options_;
+  if (!o.negative_information || !(o.negative_p_detect > 0.0) || !std::isfinite(stamp)) return std::nullopt;
+  const auto last = last_negative_.find(source_frame);
+  if (last != last_negative_.end() && stamp >= last->second && stamp - last->second < o.negative_period)
+    return std::nullopt;
+  // A node's cell: the half-edges to its neighbours (where a picker is nearer this node than that one) every
+  // 0.25 m, each point also 0.5 m to either side (a lane is 1.3-1.5 m wide). The beams towards every point
+  // must reach 0.3 m past it: a person standing anywhere in the cell, detected or not, blocks some of them.
+  constexpr double kStep = 0.25, kSide = 0.5, kSeeBeyond = 0.3;
+  std::vector<Eigen::Vector2d> people;
+  for (const auto& c : candidates) people.push_back(c.position);
+  const auto tracker = trackers_.find(source_frame);
+  if (tracker != trackers_.end())
+    for (const auto& t : tracker->second.tracks()) people.push_back(t.position);
+  const Eigen::Isometry3d sensor_from_fixed = fixed_from_sensor.inverse();
+  const Eigen::Vector2d origin = fixed_from_sensor.translation().head<2>();
+  auto inSensor = [&](const Eigen::Vector2d& p) {
+    return (sensor_from_fixed * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>().eval();
+  };
+  std::vector<double> likelihood(map.numNodes(), 1.0);
+  bool any = false;
+  for (topology::NodeIndex n : map.nodesWithin(origin, o.negative_range_max)) {
+    const Eigen::Vector2d p = map.position2d(n);
+    const double r = (p - origin).norm();
+    const double p_d = o.negative_p_detect *
+                       std::clamp((o.negative_range_max - r) / (o.negative_range_max - o.negative_range_full), 0.0, 1.0);
+    if (!(p_d > 0.0)) continue;
+    bool near_person = false;
+    for (const auto& q : people)
+      if ((q - p).norm() < o.negative_clearance) near_person = true;
+    if (near_person) continue;
+    bool seen = true;
+    auto look = [&](const Eigen::Vector2d& q) { seen = seen && seesThrough(scan, inSensor(q), kSeeBeyond); };
+    const auto& neighbours = map.neighbours(n);
+    for (topology::NodeIndex m : neighbours) {
+      const Eigen::Vector2d d = map.position2d(m) - p;
+      const double half = 0.5 * d.norm();
+      if (!(half > 0.0)) continue;
+      const Eigen::Vector2d u = d.normalized(), side(-u.y() * kSide, u.x() * kSide);
+      for (double t = 0.0; seen && t <= half + 1e-9; t += kStep) {
+        look(p + t * u);
+        look(p + t * u + side);
+        look(p + t * u - side);
+      }
+    }
+    if (neighbours.empty())
+      for (const Eigen::Vector2d& d : {Eigen::Vector2d(0, 0), Eigen::Vector2d(kSide, 0), Eigen::Vector2d(-kSide, 0),
+                                       Eigen::Vector2d(0, kSide), Eigen::Vector2d(0, -kSide)})
+        look(p + d);
+    if (!seen) continue;
+    likelihood[n] = 1.0 - p_d;
+    any = true;
+  }
+  if (!any) return std::nullopt;
+  last_negative_[source_frame] = stamp;
+  core::Observation obs;
+  obs.stamp = stamp;
+  obs.sensor = "lidar";
+  obs.robot_id = robot_id;
+  obs.identifying = false;
+  obs.nodes.resize(map.numNodes());
+  obs.likelihood = std::move(likelihood);
+  for (std::size_t n = 0; n < obs.nodes.size(); ++n) obs.nodes[n] = static_cast<topology::NodeIndex>(n);
+  return obs;
 }
 
 core::Observation LegPipeline::observation(const TrackedPerson& person, const topology::TopologicalMap& map,
