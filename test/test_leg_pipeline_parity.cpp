@@ -93,16 +93,16 @@ TEST(LegPipelineParity, NodeEqualsRunnerPipeline) {
     sensor_msgs::LaserScan s = scans[k / 2];
     s.header.stamp = ros::Time(t0 + 0.05 * static_cast<double>(k));
     s.header.frame_id = l.frame;
-    // A few open-field scans (nothing within range: +inf, REP 117) so that each laser sees through some nodes'
-    // places and sends negative information (the room of the real scans hides every map node), 2 s apart.
+    // Four open-field scans (every beam +inf, REP 117), two per laser 2.1 s apart: each laser sees through
+    // some nodes' cells and sends negative information (the room of the real scans hides every node).
     if (k == 4 || k == 5 || k == 46 || k == 47) std::fill(s.ranges.begin(), s.ranges.end(), INFINITY);
     const pl::core::LaserScan scan = pl::ros_adapter::toScanData(s);
     const auto candidates = runner.scanCandidates(scan, poseOf(l));
     for (const auto& p : runner.track(l.frame, s.header.stamp.toSec(), candidates))
       expected.push_back(pl::vision::LegPipeline::observation(p, map, s.header.stamp.toSec(), "robot_1"));
     // The negative information of the scan ("nobody at these nodes"), after its people, as the node sends it.
-    if (auto negative = runner.negativeObservation(l.frame, s.header.stamp.toSec(), scan, poseOf(l), candidates,
-                                                   map, "robot_1")) {
+    if (auto negative = runner.negativeObservation(l.frame, s.header.stamp.toSec(), scan, poseOf(l),
+                                                   candidates, map, "robot_1")) {
       expected.push_back(*negative);
       ++negatives;
     }

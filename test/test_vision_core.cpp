@@ -276,8 +276,10 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
   ASSERT_EQ(unknown.size(), 1u);  // scan_topics is a node key: known
   EXPECT_NE(unknown[0].find("'leg_treshold'"), std::string::npos) << unknown[0];
   EXPECT_NE(unknown[0].find("'leg_threshold'"), std::string::npos) << unknown[0];
-  for (const char* bad : {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}",
-                          "{hits_to_confirm: 0}", "{leg_threshold: abc}"}) {
+  for (const char* bad :
+       {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}", "{hits_to_confirm: 0}",
+        "{leg_threshold: abc}", "{negative_p_detect: 1.0}", "{negative_range_max: 2.0}",
+        "{negative_period: -1}", "{negative_clearance: -0.5}"}) {
     try {
       LegPipelineOptions::fromYaml(YAML::Load(bad));
       ADD_FAILURE() << bad << " accepted";
@@ -299,7 +301,7 @@ TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes
   auto classifier = std::make_shared<LegClassifier>();
   classifier->load(std::string(PL_PACKAGE_DIR) + "/config/leg_classifier.yml");
   LegPipeline pipeline(classifier, o);
-  // A laser at (0.75, 10.5), between lanes 0 and 1, looking along +y, 270 deg, nothing within range_max (+inf).
+  // A laser at (0.75, 10.5) between lanes 0 and 1, looking along +y, 270 deg, every beam +inf (no return).
   const Eigen::Isometry3d laser =
       Eigen::Translation3d(0.75, 10.5, 0.0) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
   core::LaserScan scan;
@@ -326,7 +328,7 @@ TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes
   EXPECT_DOUBLE_EQ(at(*obs, "r2_4"), 0.5);  // 2.7 m
   EXPECT_NEAR(at(*obs, "r1_5"), 1.0 - 0.5 * (5.0 - std::hypot(0.75, 4.5)) / 2.0, 1e-9);  // 4.6 m: tapered
   EXPECT_DOUBLE_EQ(at(*obs, "r1_3"), 1.0);  // 1.7 m behind: outside the 270 deg field of view
-  EXPECT_DOUBLE_EQ(at(*obs, "r1_9"), 1.0);    // 16.5 m: beyond negative_range_max
+  EXPECT_DOUBLE_EQ(at(*obs, "r1_9"), 1.0);  // 16.5 m: beyond negative_range_max
   // At most one per period and frame; another frame has its own period.
   EXPECT_FALSE(pipeline.negativeObservation("laser", 101.0, scan, laser, {}, map, "robot_1").has_value());
   EXPECT_TRUE(pipeline.negativeObservation("laser_rear", 101.0, scan, laser, {}, map, "robot_1").has_value());
@@ -339,7 +341,8 @@ TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes
   for (std::size_t i = 0; i < blocked.ranges.size(); ++i)
     if (std::abs(blocked.angle(i) - std::atan2(-1.05, 2.0)) < 0.05) blocked.ranges[i] = 2.26f;
   LegPipeline undetected(classifier, o);
-  const auto person_there = undetected.negativeObservation("laser", 100.0, blocked, laser, {}, map, "robot_1");
+  const auto person_there =
+      undetected.negativeObservation("laser", 100.0, blocked, laser, {}, map, "robot_1");
   ASSERT_TRUE(person_there.has_value());
   EXPECT_DOUBLE_EQ(at(*person_there, "r1_4"), 1.0);
   EXPECT_DOUBLE_EQ(at(*person_there, "r0_4"), 0.5);
@@ -365,17 +368,6 @@ TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes
   o.negative_information = false;
   LegPipeline off(classifier, o);
   EXPECT_FALSE(off.negativeObservation("laser", 100.0, scan, laser, {}, map, "robot_1").has_value());
-  // Bad values are refused by name.
-  for (const char* bad : {"{negative_p_detect: 1.0}", "{negative_range_max: 2.0}", "{negative_period: -1}",
-                          "{negative_clearance: -0.5}"}) {
-    try {
-      LegPipelineOptions::fromYaml(YAML::Load(bad));
-      ADD_FAILURE() << bad << " accepted";
-    } catch (const std::runtime_error& e) {
-      const std::string key = std::string(bad).substr(1, std::string(bad).find(':') - 1);
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
-    }
-  }
 }
 
 // Images smaller than the HOG window (64 x 128) or of another type crashed OpenCV 4.6 (issue 17): no boxes now.

@@ -453,8 +453,8 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
         const std::vector<vision::PersonCandidate> candidates = legs->scanCandidates(s, fixed_from_sensor);
         const std::vector<vision::TrackedPerson> tracked = legs->track(s.frame_id, s.stamp, candidates);
         if (spec.tracker != Tracker::kUkf)  // as leg_detector publishes it: "nobody at these nodes"
-          if (auto neg = legs->negativeObservation(s.frame_id, s.stamp, s, fixed_from_sensor, candidates, *map,
-                                                   s.robot_id))
+          if (auto neg = legs->negativeObservation(s.frame_id, s.stamp, s, fixed_from_sensor, candidates,
+                                                   *map, s.robot_id))
             toTracker(*neg);
         result.lidar_detections += tracked.size();
         // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's

@@ -234,7 +234,8 @@ void GnssIngestNode::onPerson(const picker_localisation::Observation::ConstPtr& 
   std::ostringstream key;
   key.precision(17);
   key << "person|" << msg->robot_id << "|" << msg->position.x << "|" << msg->position.y;
-  if (!in.person.position) key << "|" << in.person.nodes.size() << "|" << in.person.totalLikelihood();  // negative
+  if (!in.person.position)
+    key << "|" << in.person.nodes.size() << "|" << in.person.totalLikelihood();  // negative
   acceptPerson(std::move(in.person), key.str());
 }
 

@@ -153,10 +153,10 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   }
   last_input_ = msg->header.stamp;
   const auto scan = toScanData(*msg);
-  // REP 117: +inf is a beam that saw nothing within range_max, free space the negative information uses; a scan
-  // with neither a valid return nor such a beam (all NaN, -inf or out of limits) says nothing.
-  const bool sees_free_space = std::any_of(scan.ranges.begin(), scan.ranges.end(),
-                                           [](float r) { return std::isinf(r) && r > 0.0f; });
+  // REP 117: +inf is a beam that saw nothing within range_max, free space the negative information uses; a
+  // scan with neither a valid return nor such a beam (all NaN, -inf or out of limits) says nothing.
+  const bool sees_free_space =
+      std::any_of(scan.ranges.begin(), scan.ranges.end(), [](float r) { return std::isinf(r) && r > 0.0f; });
   if (scan.validCount() == 0 && !sees_free_space) {
     ++empty_scans_;
     ROS_WARN_THROTTLE(5.0, "%s: scan on %s has no valid return and no free beam (ignored)",
@@ -169,8 +169,8 @@ void LegDetectorNode::scanCallback(const sensor_msgs::LaserScan::ConstPtr& msg) 
   publishPeople(msg->header.frame_id, msg->header.stamp, candidates);
   if (!map_) return;
   // "Nobody at these nodes" (LegPipeline::negativeObservation), after this scan's people updated the tracks.
-  if (auto negative = pipeline_->negativeObservation(msg->header.frame_id, msg->header.stamp.toSec(), scan, tf,
-                                                     candidates, *map_, robot_id_)) {
+  if (auto negative = pipeline_->negativeObservation(msg->header.frame_id, msg->header.stamp.toSec(), scan,
+                                                     tf, candidates, *map_, robot_id_)) {
     obs_pub_.publish(toMsg(*negative, *map_, fixed_frame_));
     ++negative_observations_;
   }

@@ -30,7 +30,7 @@ const std::vector<std::string>& pipelineKeys() {
       "camera_weight",    "position_sigma",     "require_confirmed", "max_fusion_cluster_width",
       "cone_half_width",  "camera_fusion",      "threshold_reference_increment",
       "negative_information", "negative_period", "negative_p_detect", "negative_range_full",
-      "negative_range_max", "negative_clearance"};
+      "negative_range_max",   "negative_clearance"};
   return keys;
 }
 
@@ -282,8 +282,9 @@ std::optional<core::Observation> LegPipeline::negativeObservation(
   for (topology::NodeIndex n : map.nodesWithin(origin, o.negative_range_max)) {
     const Eigen::Vector2d p = map.position2d(n);
     const double r = (p - origin).norm();
-    const double p_d = o.negative_p_detect *
-                       std::clamp((o.negative_range_max - r) / (o.negative_range_max - o.negative_range_full), 0.0, 1.0);
+    const double p_d =
+        o.negative_p_detect *
+        std::clamp((o.negative_range_max - r) / (o.negative_range_max - o.negative_range_full), 0.0, 1.0);
     if (!(p_d > 0.0)) continue;
     bool near_person = false;
     for (const auto& q : people)
@@ -304,8 +305,9 @@ std::optional<core::Observation> LegPipeline::negativeObservation(
       }
     }
     if (neighbours.empty())
-      for (const Eigen::Vector2d& d : {Eigen::Vector2d(0, 0), Eigen::Vector2d(kSide, 0), Eigen::Vector2d(-kSide, 0),
-                                       Eigen::Vector2d(0, kSide), Eigen::Vector2d(0, -kSide)})
+      for (const Eigen::Vector2d& d :
+           {Eigen::Vector2d(0, 0), Eigen::Vector2d(kSide, 0), Eigen::Vector2d(-kSide, 0),
+            Eigen::Vector2d(0, kSide), Eigen::Vector2d(0, -kSide)})
         look(p + d);
     if (!seen) continue;
     likelihood[n] = 1.0 - p_d;

@@ -66,9 +66,9 @@ class LegDetectorNode {
   picker_localisation::BearingDetectionArray::ConstPtr last_detections_;
   sensor_msgs::CameraInfo::ConstPtr camera_info_;
   NodeDiagnostics diagnostics_;  // published at 1 Hz (ROS time)
-  std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0, negative_observations_ = 0,
-              camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0, bad_detections_ = 0,
-              bad_scans_ = 0;
+  std::size_t scans_ = 0, empty_scans_ = 0, tf_failures_ = 0, clouds_ = 0, people_ = 0, observations_ = 0,
+              negative_observations_ = 0, camera_frames_ = 0, fused_ = 0, bad_clouds_ = 0,
+              bad_detections_ = 0, bad_scans_ = 0;
   StampGuard stamp_guard_;
   ros::Time last_input_;
 };

@@ -36,15 +36,15 @@ struct LegPipelineOptions {
   double max_fusion_cluster_width =
       0.8;                       // m, unclassified clusters up to this width may be promoted by a cone
   double cone_half_width = 0.1;  // rad, half width of a cone when the box edges are unknown
-  // Negative information (LegPipeline::negativeObservation): a laser that sees through the place of a map node
-  // and finds nobody there says the picker is not at that node, with the probability that it would have
+  // Negative information (LegPipeline::negativeObservation): a laser that sees through the place of a map
+  // node and finds nobody there says the picker is not at that node, with the probability that it would have
   // detected a person standing there.
   bool negative_information = true;
-  double negative_period = 2.0;       // s, at most one negative observation per laser frame per period
-  double negative_p_detect = 0.5;     // detection probability of a person in clear view within negative_range_full
-  double negative_range_full = 3.0;   // m from the laser: p_detect up to here, falling linearly to 0 at
-  double negative_range_max = 5.0;    // m
-  double negative_clearance = 1.5;    // m, nodes this close to a person candidate or live track get none
+  double negative_period = 2.0;      // s, at most one negative observation per laser frame per period
+  double negative_p_detect = 0.5;    // detection probability in clear view up to negative_range_full
+  double negative_range_full = 3.0;  // m from the laser: p_detect up to here, falling linearly to 0 at
+  double negative_range_max = 5.0;   // m
+  double negative_clearance = 1.5;   // m, nodes this close to a person candidate or live track get none
 
   // Reads the flat keys of config/vision.yaml's `leg_detector:` section (missing keys keep the defaults).
   // Keys that only concern the node (topics, frames, timeouts) are accepted and ignored. `unknown`, when
@@ -111,8 +111,8 @@ class LegPipeline {
   //                          negative_clearance,
   //   L(n) = 1              everywhere else (out of view, occluded, or someone is there),
   // p_d(r) = negative_p_detect up to negative_range_full from the laser, linearly down to 0 at
-  // negative_range_max. Issued at most once per negative_period per frame (successive scans of one place are not
-  // independent looks); none when disabled, the period has not elapsed or no node qualifies. The same
+  // negative_range_max. Issued at most once per negative_period per frame (successive scans of one place are
+  // not independent looks); none when disabled, the period has not elapsed or no node qualifies. The same
   // observation concerns every picker: it only says "no person here".
   std::optional<core::Observation> negativeObservation(const std::string& source_frame, double stamp,
                                                        const core::LaserScan& scan,
