@@ -84,6 +84,12 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   return "";
 }
 
+void setLikelihoodOverEveryNode(Observation& obs, std::size_t num_nodes) {
+  obs.nodes.resize(num_nodes);
+  for (std::size_t n = 0; n < num_nodes; ++n) obs.nodes[n] = static_cast<topology::NodeIndex>(n);
+  obs.likelihood.assign(num_nodes, 1.0);
+}
+
 bool concernsPicker(bool identifying, const std::string& identified,
                     const std::vector<std::string>& candidates, const std::string& picker_id) {
   if (identifying) return identified == picker_id;

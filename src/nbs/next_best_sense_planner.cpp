@@ -389,9 +389,7 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
       read.likelihood.clear();
       // p(seen | n), scaled so that a node seen by RFID alone has 1 (RFID only: the paper's L(n) = 1).
       for (NodeIndex m : region) read.likelihood.push_back((1.0 - p_miss[m]) / rfid.p_detect);
-      no_read.nodes.resize(n);
-      no_read.likelihood.assign(n, 1.0);
-      for (std::size_t m = 0; m < n; ++m) no_read.nodes[m] = static_cast<NodeIndex>(m);
+      core::setLikelihoodOverEveryNode(no_read, n);
       for (NodeIndex m : region) no_read.likelihood[m] = p_miss[m];
       const NodeMasses post_read = p.source->posterior(horizon, read);
       const NodeMasses post_none = p.source->posterior(horizon, no_read);

@@ -261,9 +261,7 @@ std::vector<core::Observation> RfidObservationModel::negativeObservations(const 
     obs.robot_id = read.robot_id;
     obs.picker_id = p.id;
     obs.identifying = true;
-    obs.nodes.resize(map_->numNodes());
-    obs.likelihood.assign(map_->numNodes(), 1.0);
-    for (topology::NodeIndex n = 0; n < map_->numNodes(); ++n) obs.nodes[n] = n;
+    core::setLikelihoodOverEveryNode(obs, map_->numNodes());
     // L(n) = 1 - p_detect * p_read(d(n)) / p_max (disc: 1 - p_detect inside), floored away from 0.
     const double scale = logistic_ ? options_.p_detect / options_.p_max : options_.p_detect;
     for (topology::NodeIndex n : inside) {

@@ -277,7 +277,8 @@ std::optional<core::Observation> LegPipeline::negativeObservation(
   auto inSensor = [&](const Eigen::Vector2d& p) {
     return (sensor_from_fixed * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>().eval();
   };
-  std::vector<double> likelihood(map.numNodes(), 1.0);
+  core::Observation obs;
+  core::setLikelihoodOverEveryNode(obs, map.numNodes());
   bool any = false;
   for (topology::NodeIndex n : map.nodesWithin(origin, o.negative_range_max)) {
     const Eigen::Vector2d p = map.position2d(n);
@@ -286,10 +287,9 @@ std::optional<core::Observation> LegPipeline::negativeObservation(
         o.negative_p_detect *
         std::clamp((o.negative_range_max - r) / (o.negative_range_max - o.negative_range_full), 0.0, 1.0);
     if (!(p_d > 0.0)) continue;
-    bool near_person = false;
-    for (const auto& q : people)
-      if ((q - p).norm() < o.negative_clearance) near_person = true;
-    if (near_person) continue;
+    if (std::any_of(people.begin(), people.end(),
+                    [&](const Eigen::Vector2d& q) { return (q - p).norm() < o.negative_clearance; }))
+      continue;
     bool seen = true;
     auto look = [&](const Eigen::Vector2d& q) { seen = seen && seesThrough(scan, inSensor(q), kSeeBeyond); };
     const auto& neighbours = map.neighbours(n);
@@ -310,19 +310,15 @@ std::optional<core::Observation> LegPipeline::negativeObservation(
             Eigen::Vector2d(0, kSide), Eigen::Vector2d(0, -kSide)})
         look(p + d);
     if (!seen) continue;
-    likelihood[n] = 1.0 - p_d;
+    obs.likelihood[n] = 1.0 - p_d;
     any = true;
   }
   if (!any) return std::nullopt;
   last_negative_[source_frame] = stamp;
-  core::Observation obs;
   obs.stamp = stamp;
   obs.sensor = "lidar";
   obs.robot_id = robot_id;
   obs.identifying = false;
-  obs.nodes.resize(map.numNodes());
-  obs.likelihood = std::move(likelihood);
-  for (std::size_t n = 0; n < obs.nodes.size(); ++n) obs.nodes[n] = static_cast<topology::NodeIndex>(n);
   return obs;
 }
 

@@ -47,6 +47,10 @@ bool concernsPicker(const Observation& obs, const std::string& picker_id);
 bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
                     const std::string& picker_id);
 
+// Negative-information form: every node of a map of `num_nodes` listed, with likelihood 1 (the caller then
+// lowers the nodes the evidence concerns, e.g. an antenna that did not read, a laser that saw nobody).
+void setLikelihoodOverEveryNode(Observation& obs, std::size_t num_nodes);
+
 // Options of a Gaussian node likelihood.
 struct GaussianLikelihoodOptions {
   double cutoff_sigmas = 3.0;     // nodes farther than this many (largest) standard deviations are left out
