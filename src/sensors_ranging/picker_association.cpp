@@ -87,25 +87,31 @@ double IdentityEvidence::ratio(const std::string& picker_id, double t, const Eig
   // polynomial of degree 5 in each axis.
   static const double kNode[3] = {0.0, std::sqrt(3.0), -std::sqrt(3.0)};
   static const double kWeight[3] = {2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0};
-  topology::NodeIndex points[9];
-  topology::NodeIndex at_detection = topology::kInvalidNode;  // found with the first evidence in the window
+  topology::TopologicalMap::EdgePoint points[9];
+  topology::TopologicalMap::EdgePoint at_detection;  // found with the first evidence in the window
   double rho = 1.0;
   for (const auto& entry : picker->second) {
     const Item& item = entry.second;
     if (std::abs(t - item.stamp) > o.identity_window) continue;
-    if (at_detection ==
-        topology::kInvalidNode) {  // this runs per detection and picker: no lookups until needed
+    if (at_detection.from == topology::kInvalidNode) {  // per detection and picker: no lookups until needed
       const Eigen::LLT<Eigen::Matrix2d> llt(0.5 * (covariance + covariance.transpose()));
       if (llt.info() != Eigen::Success) return 1.0;
       const Eigen::Matrix2d root = llt.matrixL();
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
-          points[3 * a + b] = map.nearestNode(mean + root * Eigen::Vector2d(kNode[a], kNode[b]));
-      at_detection = map.nearestNode(z);
+          points[3 * a + b] = map.nearestEdgePoint(mean + root * Eigen::Vector2d(kNode[a], kNode[b]));
+      at_detection = map.nearestEdgePoint(z);
     }
-    auto value = [&item](topology::NodeIndex n) {
+    auto at_node = [&item](topology::NodeIndex n) {
       const auto it = item.likelihood.find(n);
       return it == item.likelihood.end() ? 0.0 : it->second;
+    };
+    // L read where the point is, between the two nodes of its edge (not at the nearest node: on a lane with
+    // nodes 3.3 m apart a picker read 4 m from the antenna can stand 1.7 m from the nearest node, whose L
+    // after failed read attempts is ~0, and the ratio then refused the true picker by 16x).
+    auto value = [&at_node](const topology::TopologicalMap::EdgePoint& q) {
+      const double l = at_node(q.from);
+      return q.to == topology::kInvalidNode ? l : l + q.fraction * (at_node(q.to) - l);
     };
     double expected = 0.0;
     for (int a = 0; a < 3; ++a)

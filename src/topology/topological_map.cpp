@@ -368,6 +368,26 @@ double TopologicalMap::distanceToNearestNode(const Eigen::Vector2d& p) const {
   return (position2d(nearestNode(p)) - p).norm();
 }
 
+TopologicalMap::EdgePoint TopologicalMap::nearestEdgePoint(const Eigen::Vector2d& p) const {
+  EdgePoint best;
+  if (nodes_.empty()) return best;
+  best.from = nearestNode(p);
+  const Eigen::Vector2d a = position2d(best.from);
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (NodeIndex n : neighbours(best.from)) {
+    const Eigen::Vector2d ab = position2d(n) - a;
+    const double length2 = ab.squaredNorm();
+    const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+    const double d = (a + t * ab - p).squaredNorm();
+    if (d < best_distance) {
+      best_distance = d;
+      best.to = n;
+      best.fraction = t;
+    }
+  }
+  return best;
+}
+
 std::vector<NodeIndex> TopologicalMap::nodesWithin(const Eigen::Vector2d& p, double radius) const {
   std::vector<NodeIndex> out;
   if (!(radius >= 0.0) || nodes_.empty()) return out;

@@ -74,8 +74,9 @@ std::vector<BeliefView> beliefViews(const std::vector<const BeliefHistory*>& his
 // 644 of 661 wrong identifications. For each picker, the newest identifying observation of every (sensor,
 // robot) in identity_sensors is kept (a read, or an antenna's negative observation for a tag it has not read)
 // and weighs l_i by
-//   rho_i(z) = max(L(n(z)), floor) / max(E_{x ~ N(prediction_i)}[L(n(x))], floor)
-// with L the observation's own likelihood over nodes, n(x) the node nearest x and the expectation a 3 x 3
+//   rho_i(z) = max(L(z), floor) / max(E_{x ~ N(prediction_i)}[L(x)], floor)
+// with L the observation's own likelihood over nodes, read at a position x on the graph point nearest x
+// (TopologicalMap::nearestEdgePoint: linear between the two nodes of the edge) and the expectation a 3 x 3
 // Gauss-Hermite rule over the picker's predicted position (bias-corrected fix, the g_i term). rho > 1: the
 // observation is better explained by the picker standing at the detection than where it is predicted (a read
 // next to the detection of a picker whose fix is 9 m away); rho < 1: worse (an antenna 1 m from the detection
