@@ -291,6 +291,7 @@ TEST(RfidObservationModel, LogisticReadProbabilityLikelihood) {
   auto map = latticeMap(10.0, 1.0);
   RfidModelOptions o;
   o.negative_information = false;
+  o.attempt_rate = 0.0;  // the read alone, L = p_read (failed attempts: FailedAttemptsBetweenReadsCount)
   RfidObservationModel rfid(twoPickers(), map, o);
   EXPECT_NEAR(rfid.regionRadius(), 7.2165838951, 1e-9);
   EXPECT_NEAR(rfid.readProbability(0.0), 0.9468767217, 1e-9);
@@ -842,7 +843,9 @@ TEST(FrontEndOptions, GnssAndRfidFromYaml) {
 
 TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
   // Two reads of one tag by one antenna 2 s apart at attempt_rate 2 Hz: m = round(2 * 2) - 1 = 3 failed
-  // attempts, so the second read's likelihood is p (1 - p)^3 (hand values from p_read(0) and p_read(4)).
+  // attempts, so the second read's likelihood is p (1 - p)^3 (hand values from p_read(0) and p_read(4)). The
+  // first read of the tag follows the cap, max_failed_attempts = 10 (the reader was inventorying while the
+  // robot came into range), and so does a read after a gap the cap covers (>= 5.5 s at 2 Hz).
   auto map = latticeMap(10.0, 1.0);
   RfidModelOptions o;
   o.negative_information = false;
@@ -852,34 +855,41 @@ TEST(RfidObservationModel, FailedAttemptsBetweenReadsCount) {
   read.robot_id = "robot_1";
   read.frame_id = "robot_1/rfid_antenna";
   read.tag_id = "rfid_2";
-  const RfidResult first = rfid.process(read);
-  ASSERT_TRUE(first.accepted());
-  EXPECT_NEAR(likelihoodAt(*first.observation, nodeAt(*map, 0, 0)), 0.9468767217,
-              1e-9);  // first read: p alone
+  const double p0 = 0.9468767217, p4 = 0.475;
+  auto expectFailed = [&](const RfidResult& r, int m) {
+    ASSERT_TRUE(r.accepted());
+    // Relative 1e-7: p0 has 10 digits, and (1 - p0)^10 multiplies its relative error by 10 p0 / (1 - p0).
+    const double at_antenna = p0 * std::pow(1.0 - p0, m), at_4m = p4 * std::pow(1.0 - p4, m);
+    EXPECT_NEAR(likelihoodAt(*r.observation, nodeAt(*map, 0, 0)), at_antenna, 1e-7 * at_antenna);
+    EXPECT_NEAR(likelihoodAt(*r.observation, nodeAt(*map, 4, 0)), at_4m, 1e-9 * at_4m);
+  };
+  expectFailed(rfid.process(read), 10);  // first read
   read.stamp = 3.0;
   const RfidResult second = rfid.process(read);
-  ASSERT_TRUE(second.accepted());
-  const double p0 = 0.9468767217, p4 = 0.475;
-  EXPECT_NEAR(likelihoodAt(*second.observation, nodeAt(*map, 0, 0)), p0 * std::pow(1.0 - p0, 3), 1e-9);
-  EXPECT_NEAR(likelihoodAt(*second.observation, nodeAt(*map, 4, 0)), p4 * std::pow(1.0 - p4, 3), 1e-9);
+  expectFailed(second, 3);
   // The tag is now more likely 4 m from the antenna than next to it.
   EXPECT_GT(likelihoodAt(*second.observation, nodeAt(*map, 4, 0)),
             likelihoodAt(*second.observation, nodeAt(*map, 0, 0)));
+  read.stamp = 3.5;
+  expectFailed(rfid.process(read), 0);  // the next attempt read it again
+  read.stamp = 8.5;                     // 5 s: 9 failed attempts
+  expectFailed(rfid.process(read), 9);
+  read.stamp = 14.0;  // 5.5 s and 60 s: the cap, not 0 (a gap just over 5 s once counted none)
+  expectFailed(rfid.process(read), 10);
+  read.stamp = 74.0;
+  expectFailed(rfid.process(read), 10);
   // After the clock jumped back (reset), a read 2 s after a "previous" one is a first read again: no failed
-  // attempts are counted across the jump.
+  // attempts are counted from a read before the jump, the cap as for any first read.
   rfid.reset();
   read.stamp = 1.5;
-  const RfidResult after_reset = rfid.process(read);
-  ASSERT_TRUE(after_reset.accepted());
-  EXPECT_NEAR(likelihoodAt(*after_reset.observation, nodeAt(*map, 0, 0)), p0, 1e-9);
-  read.stamp = 3.0;  // restore the sequence the rest of the test expects
+  expectFailed(rfid.process(read), 10);
   // attempt_rate 0: reads only (the former model).
   o.attempt_rate = 0.0;
   RfidObservationModel plain(twoPickers(), map, o);
   read.stamp = 1.0;
-  plain.process(read);
+  expectFailed(plain.process(read), 0);
   read.stamp = 3.0;
-  EXPECT_NEAR(likelihoodAt(*plain.process(read).observation, nodeAt(*map, 0, 0)), p0, 1e-9);
+  expectFailed(plain.process(read), 0);
 }
 
 // ---------------------------------------------------------------------------------------------------------
@@ -1164,10 +1174,10 @@ core::Observation squareEvidence(const topology::TopologicalMap& map, const std:
 }
 }  // namespace
 
-// rho = max(L(n(z)), floor) / max(E[L(n(x))], floor), the expectation a 3 x 3 Gauss-Hermite rule (nodes 0,
-// +-sqrt(3) sigma, weights 2/3, 1/6) over the prediction; computed by hand on a 1 m lattice.
+// rho = max(L(z), floor) / max(E[L(x)], floor) with L read between the two nodes of the nearest edge, the expectation a 3 x 3 Gauss-Hermite rule (nodes 0, +-sqrt(3) sigma, weights 2/3, 1/6) over
+// the prediction; computed by hand on a 1 m lattice.
 TEST(IdentityEvidence, RatioOfTheObservationAtTheDetectionToItsExpectation) {
-  const auto map = latticeMap(20.0, 1.0);
+  const auto map = latticeMap(20.0, 1.0, true);
   PickerAssociationOptions o;  // floor 0.02, window 5 s, sensors rfid, uwb
   IdentityEvidence e;
   const Eigen::Vector2d z(0.0, 0.0);
@@ -1176,6 +1186,10 @@ TEST(IdentityEvidence, RatioOfTheObservationAtTheDetectionToItsExpectation) {
   ASSERT_TRUE(e.add(squareEvidence(*map, "picker_1", 0.0, 0.9), o));
   // A read next to the detection of a picker predicted 10 m away: 0.9 / floor.
   EXPECT_NEAR(e.ratio("picker_1", 0.5, z, {10.0, 0.0}, sharp, *map, o), 0.9 / 0.02, 1e-9);
+  // Between the last node inside (x = 2) and the first outside (x = 3): half way, L = 0.45, not the nearest
+  // node's 0.9 or 0; 0.2 m along and 0.1 m off that edge: 0.72.
+  EXPECT_NEAR(e.ratio("picker_1", 0.5, {2.5, 0.0}, {0.0, 0.0}, sharp, *map, o), 0.5, 1e-12);
+  EXPECT_NEAR(e.ratio("picker_1", 0.5, {2.2, 0.1}, {0.0, 0.0}, sharp, *map, o), 0.8, 1e-12);
   // Predicted where it was read: no change, however wide when every rule point falls inside (sqrt(3) -> 2 m).
   EXPECT_NEAR(e.ratio("picker_1", 0.5, z, {0.0, 0.0}, sharp, *map, o), 1.0, 1e-12);
   EXPECT_NEAR(e.ratio("picker_1", 0.5, z, {0.0, 0.0}, Eigen::Matrix2d::Identity(), *map, o), 1.0, 1e-12);

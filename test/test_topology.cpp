@@ -208,6 +208,38 @@ TEST(Queries, UnreachableNodes) {
   EXPECT_EQ(d.numUndirectedEdges(), 1u);
 }
 
+// A T of three edges: a (0,0) - b (4,0) - c (8,0), and b - d (4,3); island e (20,0) has none.
+TEST(Queries, NearestEdgePointProjectsOntoTheClosestEdgeAtTheNearestNode) {
+  std::vector<Node> nodes(5);
+  const double xy[5][2] = {{0, 0}, {4, 0}, {8, 0}, {4, 3}, {20, 0}};
+  for (int i = 0; i < 5; ++i) {
+    nodes[i].name = std::string(1, static_cast<char>('a' + i));
+    nodes[i].position = Eigen::Vector3d(xy[i][0], xy[i][1], 0.0);
+  }
+  const TopologicalMap m = TopologicalMap::build("t", nodes, {{"ab", "a", "b", ""}, {"bc", "b", "c", ""}, {"bd", "b", "d", ""}});
+  // 1 m from a along a-b, 0.2 m off it (hand: fraction 1/4 from a).
+  TopologicalMap::EdgePoint q = m.nearestEdgePoint({1.0, 0.2});
+  EXPECT_EQ(q.from, 0u);
+  EXPECT_EQ(q.to, 1u);
+  EXPECT_NEAR(q.fraction, 0.25, 1e-12);
+  // Nearest node b; the edge to d (0.3 m off) is closer than b-c (1.2 m off): fraction 1.2 / 3 towards d.
+  q = m.nearestEdgePoint({4.3, 1.2});
+  EXPECT_EQ(q.from, 1u);
+  EXPECT_EQ(q.to, 3u);
+  EXPECT_NEAR(q.fraction, 0.4, 1e-12);
+  // Beyond an end: clamped at the node (fraction 0).
+  q = m.nearestEdgePoint({-2.0, 0.0});
+  EXPECT_EQ(q.from, 0u);
+  EXPECT_EQ(q.fraction, 0.0);
+  // A node without edges: no second node.
+  q = m.nearestEdgePoint({19.0, 1.0});
+  EXPECT_EQ(q.from, 4u);
+  EXPECT_EQ(q.to, kInvalidNode);
+  EXPECT_EQ(q.fraction, 0.0);
+  // Empty map: nothing.
+  EXPECT_EQ(TopologicalMap().nearestEdgePoint({0.0, 0.0}).from, kInvalidNode);
+}
+
 TEST(Lanes, RowTraversalRuleOnRiseholme) {
   TopologicalMap m = loadMap(kTmap2);
   // 12 rows of 10 nodes joined by row_traversal edges; 18 headland / dock nodes outside every lane.

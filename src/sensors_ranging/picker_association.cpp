@@ -69,6 +69,10 @@ bool IdentityEvidence::add(const core::Observation& obs, const PickerAssociation
     return false;
   Item& item = items_[obs.picker_id][obs.sensor + "|" + obs.robot_id];
   if (!item.likelihood.empty() && obs.stamp < item.stamp) return false;
+  // Kept as published, not scaled to max 1: a read after many failed attempts, p (1 - p)^m, lies below the
+  // floor everywhere and so changes no association. Scaled, its far-from-the-antenna shape (the attempts were
+  // made from poses up to 5 m back) changed them 50x: three pickers, seeds 1..80, right lane 0.785 -> 0.775
+  // (paired difference -0.010, 2.6 standard errors), wrong identities 598 -> 574.
   item.stamp = obs.stamp;
   item.likelihood.clear();
   item.likelihood.reserve(obs.nodes.size());

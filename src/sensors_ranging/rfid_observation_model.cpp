@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -198,16 +199,19 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     antenna_session_start_[read.frame_id] = read.stamp;
   antenna_last_stamp_[read.frame_id] =
       std::max(read.stamp, last == antenna_last_stamp_.end() ? read.stamp : last->second);
-  // Failed attempts of this antenna on this picker's tag since its previous read (see attempt_rate).
+  // Failed attempts of this antenna on this picker's tag since its previous read (see attempt_rate). The
+  // first read of the tag, or one after a gap longer than the cap covers, follows max_failed_attempts: the
+  // reader inventories all the time, so a tag read only now was not read while the robot came into range
+  // (counting none there placed it next to the antenna, and a gap of 5.1 s counted 0 where 5.0 s counted 9).
   int failed = 0;
-  {
+  if (options_.attempt_rate > 0.0 && logistic_) {
     auto prev = last_read_.find({read.frame_id, *picker});
-    if (options_.attempt_rate > 0.0 && logistic_ && prev != last_read_.end()) {
-      const double gap = read.stamp - prev->second;
-      if (gap > 0.0 && gap <= options_.negative_window)
-        failed = std::clamp(static_cast<int>(std::lround(gap * options_.attempt_rate)) - 1, 0,
-                            options_.max_failed_attempts);
-    }
+    const double gap = prev == last_read_.end() ? std::numeric_limits<double>::infinity()
+                                                : read.stamp - prev->second;
+    if (gap > 0.0)
+      failed = gap * options_.attempt_rate >= options_.max_failed_attempts + 1.0
+                   ? options_.max_failed_attempts
+                   : std::max(static_cast<int>(std::lround(gap * options_.attempt_rate)) - 1, 0);
   }
   last_read_[{read.frame_id, *picker}] = read.stamp;
   ++counters_.accepted;

@@ -74,11 +74,13 @@ struct RfidModelOptions {
   double out_of_order_tolerance = 0.0;  // s, reads older than the antenna's newest read by more are rejected
   // Read attempts per second of one antenna for one tag (the reader's inventory rate; the simulator's
   // rfid.rate). > 0: a read that follows the same antenna's previous read of the same picker after a gap
-  // (<= negative_window) also counts the m = round(gap * attempt_rate) - 1 failed attempts in between:
-  // L(n) = p_read(d) (1 - p_read(d))^m, so a tag read now and then is placed away from the antenna instead
-  // of next to it (successful reads alone pull the belief towards the robot). 0: L(n) = p_read(d).
+  // also counts the m = round(gap * attempt_rate) - 1 failed attempts in between, the first read of a tag
+  // (an infinite gap) max_failed_attempts: L(n) = p_read(d) (1 - p_read(d))^m, so a tag read now and then,
+  // or read for the first time as the robot comes into range, is placed away from the antenna instead of next
+  // to it (successful reads alone pull the belief towards the robot). 0: L(n) = p_read(d).
   double attempt_rate = 2.0;
-  int max_failed_attempts = 10;  // cap on m (the robot moves during a long gap)
+  int max_failed_attempts = 10;  // cap on m: the likelihood is taken at the antenna's pose of the read, and the
+                                 // robot moves during a long gap (1 m/s: 5 m in the 10 attempts of 5 s)
 
   // The keys of config/rfid_ranging.yaml (node-only keys accepted and ignored), as GnssIngestOptions::fromYaml.
   static RfidModelOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
