@@ -12,8 +12,8 @@ namespace ranging_test {
 
 // Nodes every `spacing` m over [-half, half]^2, named n_<i>_<j>; `connected`: edges both ways between
 // 4-neighbours.
-inline std::shared_ptr<const picker_localisation::topology::TopologicalMap> latticeMap(double half, double spacing,
-                                                                                      bool connected = false) {
+inline std::shared_ptr<const picker_localisation::topology::TopologicalMap> latticeMap(
+    double half, double spacing, bool connected = false) {
   using picker_localisation::topology::EdgeSpec;
   using picker_localisation::topology::Node;
   using picker_localisation::topology::TopologicalMap;

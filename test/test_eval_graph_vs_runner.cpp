@@ -117,8 +117,9 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
       if (sample.topological >= 0)
         per_picker[sample.picker_id].first += sample.topological, ++per_picker[sample.picker_id].second;
     for (const auto& [id, sum] : per_picker)
-      std::printf("runner (tracker seed %llu) %s: topological %.2f nodes\n", static_cast<unsigned long long>(ts),
-                  id.c_str(), sum.first / static_cast<double>(sum.second));
+      std::printf("runner (tracker seed %llu) %s: topological %.2f nodes\n",
+                  static_cast<unsigned long long>(ts), id.c_str(),
+                  sum.first / static_cast<double>(sum.second));
     off_eu += m.euclidean_mean / 4.0;
     off_topo += m.topological_mean / 4.0;
   }

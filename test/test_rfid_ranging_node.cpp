@@ -70,8 +70,8 @@ TEST(RfidRangingNode, BadReadsAreDroppedAndGoodOnesStillPublish) {
     if (o.picker_id == "picker_1") {
       EXPECT_NEAR(o.position.x, 20.0, 1e-9);
       EXPECT_NEAR(o.position.y, -20.0, 1e-9);
-      // Logistic read model with failed attempts (config/rfid_ranging.yaml): L(n) = p_read(d(n)) (1 - p_read)^m
-      // in (0, p_max], m = 10 for the tag's first read.
+      // Logistic read model with failed attempts (config/rfid_ranging.yaml):
+      // L(n) = p_read(d(n)) (1 - p_read(d(n)))^m in (0, p_max], m = 10 for the tag's first read.
       for (double l : o.likelihood) {
         EXPECT_GT(l, 0.0);
         EXPECT_LE(l, 0.95);

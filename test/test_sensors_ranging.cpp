@@ -1174,8 +1174,9 @@ core::Observation squareEvidence(const topology::TopologicalMap& map, const std:
 }
 }  // namespace
 
-// rho = max(L(z), floor) / max(E[L(x)], floor) with L read between the two nodes of the nearest edge, the expectation a 3 x 3 Gauss-Hermite rule (nodes 0, +-sqrt(3) sigma, weights 2/3, 1/6) over
-// the prediction; computed by hand on a 1 m lattice.
+// rho = max(L(z), floor) / max(E[L(x)], floor) with L read between the two nodes of the nearest edge, the
+// expectation a 3 x 3 Gauss-Hermite rule (nodes 0, +-sqrt(3) sigma, weights 2/3, 1/6) over the prediction;
+// computed by hand on a 1 m lattice.
 TEST(IdentityEvidence, RatioOfTheObservationAtTheDetectionToItsExpectation) {
   const auto map = latticeMap(20.0, 1.0, true);
   PickerAssociationOptions o;  // floor 0.02, window 5 s, sensors rfid, uwb

@@ -216,7 +216,8 @@ TEST(Queries, NearestEdgePointProjectsOntoTheClosestEdgeAtTheNearestNode) {
     nodes[i].name = std::string(1, static_cast<char>('a' + i));
     nodes[i].position = Eigen::Vector3d(xy[i][0], xy[i][1], 0.0);
   }
-  const TopologicalMap m = TopologicalMap::build("t", nodes, {{"ab", "a", "b", ""}, {"bc", "b", "c", ""}, {"bd", "b", "d", ""}});
+  const TopologicalMap m =
+      TopologicalMap::build("t", nodes, {{"ab", "a", "b", ""}, {"bc", "b", "c", ""}, {"bd", "b", "d", ""}});
   // 1 m from a along a-b, 0.2 m off it (hand: fraction 1/4 from a).
   TopologicalMap::EdgePoint q = m.nearestEdgePoint({1.0, 0.2});
   EXPECT_EQ(q.from, 0u);

@@ -206,8 +206,8 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
   int failed = 0;
   if (options_.attempt_rate > 0.0 && logistic_) {
     auto prev = last_read_.find({read.frame_id, *picker});
-    const double gap = prev == last_read_.end() ? std::numeric_limits<double>::infinity()
-                                                : read.stamp - prev->second;
+    const double gap =
+        prev == last_read_.end() ? std::numeric_limits<double>::infinity() : read.stamp - prev->second;
     if (gap > 0.0)
       failed = gap * options_.attempt_rate >= options_.max_failed_attempts + 1.0
                    ? options_.max_failed_attempts

@@ -79,8 +79,8 @@ struct RfidModelOptions {
   // or read for the first time as the robot comes into range, is placed away from the antenna instead of next
   // to it (successful reads alone pull the belief towards the robot). 0: L(n) = p_read(d).
   double attempt_rate = 2.0;
-  int max_failed_attempts = 10;  // cap on m: the likelihood is taken at the antenna's pose of the read, and the
-                                 // robot moves during a long gap (1 m/s: 5 m in the 10 attempts of 5 s)
+  int max_failed_attempts = 10;  // cap on m: the likelihood is taken at the antenna's pose of the read, and
+                                 // the robot moves during a long gap (1 m/s: 5 m in the 10 attempts of 5 s)
 
   // The keys of config/rfid_ranging.yaml (node-only keys accepted and ignored), as GnssIngestOptions::fromYaml.
   static RfidModelOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);

@@ -140,9 +140,9 @@ class TopologicalMap {
   // Distance (m, xy-plane) from p to that node; +inf for an empty map. How far off the map a point is.
   double distanceToNearestNode(const Eigen::Vector2d& p) const;
   // The point of the graph nearest p among the edges at the nearest node: p projected onto the closest of
-  // those edges, `fraction` of the way from `from` (the nearest node) to `to`. A node without neighbours (or an
-  // empty map: both invalid) gives to == kInvalidNode, fraction 0. Lets a quantity known per node be read at a
-  // position between two nodes (by linear interpolation) instead of at the nearest node, which on a lane
+  // those edges, `fraction` of the way from `from` (the nearest node) to `to`. A node without neighbours (or
+  // an empty map: both invalid) gives to == kInvalidNode, fraction 0. Lets a quantity known per node be read
+  // at a position between two nodes (by linear interpolation) instead of at the nearest node, which on a lane
   // with nodes 3 m apart can be 1.5 m from p.
   struct EdgePoint {
     NodeIndex from = kInvalidNode;
