@@ -81,18 +81,18 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
   for (const auto& [id, list] : errors) {
     double picker_topo = 0.0;
     std::size_t picker_n = 0;
-    for (const auto& e : list)
-      if (e.topological_error >= 0) picker_topo += e.topological_error, ++picker_n;
-    std::printf("graph %s: topological %.2f nodes over %zu samples\n", id.c_str(),
-                picker_topo / static_cast<double>(std::max<std::size_t>(picker_n, 1)), picker_n);
     for (const auto& e : list) {
       graph_eu += e.euclidean_error;
       if (e.topological_error >= 0) {
-        graph_topo += e.topological_error;
-        ++n_topo;
+        picker_topo += e.topological_error;
+        ++picker_n;
       }
       ++n;
     }
+    graph_topo += picker_topo;
+    n_topo += picker_n;
+    std::printf("graph %s: topological %.2f nodes over %zu samples\n", id.c_str(),
+                picker_topo / static_cast<double>(std::max<std::size_t>(picker_n, 1)), picker_n);
   }
   graph_eu /= static_cast<double>(n);
   graph_topo /= static_cast<double>(n_topo);
@@ -112,14 +112,12 @@ TEST(EvalGraphVsRunner, ErrorsAgreeWithOfflineRunner) {
     const eval::RunResult run = eval::runOnce(map, rc);
     off_lidar = run.lidar_detections;  // the same for every tracker seed
     const eval::RunMetrics m = eval::summariseRun(run.samples);
-    std::map<std::string, std::pair<double, std::size_t>> per_picker;  // the same per picker, for the log
-    for (const auto& sample : run.samples)
-      if (sample.topological >= 0)
-        per_picker[sample.picker_id].first += sample.topological, ++per_picker[sample.picker_id].second;
-    for (const auto& [id, sum] : per_picker)
+    std::map<std::string, std::vector<eval::ErrorSample>> per_picker;  // the same per picker, for the log
+    for (const auto& sample : run.samples) per_picker[sample.picker_id].push_back(sample);
+    for (const auto& [id, samples] : per_picker)
       std::printf("runner (tracker seed %llu) %s: topological %.2f nodes\n",
                   static_cast<unsigned long long>(ts), id.c_str(),
-                  sum.first / static_cast<double>(sum.second));
+                  eval::summariseRun(samples).topological_mean);
     off_eu += m.euclidean_mean / 4.0;
     off_topo += m.topological_mean / 4.0;
   }

@@ -208,10 +208,10 @@ RfidResult RfidObservationModel::process(const RfidRead& read) {
     auto prev = last_read_.find({read.frame_id, *picker});
     const double gap =
         prev == last_read_.end() ? std::numeric_limits<double>::infinity() : read.stamp - prev->second;
-    if (gap > 0.0)
-      failed = gap * options_.attempt_rate >= options_.max_failed_attempts + 1.0
-                   ? options_.max_failed_attempts
-                   : std::max(static_cast<int>(std::lround(gap * options_.attempt_rate)) - 1, 0);
+    if (gap > 0.0) {  // attempts in the gap, bounded before rounding (an infinite gap has no lround)
+      const double attempts = std::min(gap * options_.attempt_rate, options_.max_failed_attempts + 1.0);
+      failed = std::clamp(static_cast<int>(std::lround(attempts)) - 1, 0, options_.max_failed_attempts);
+    }
   }
   last_read_[{read.frame_id, *picker}] = read.stamp;
   ++counters_.accepted;
