@@ -39,6 +39,10 @@ own_master() {  # log args...
   local port=$((20000 + RANDOM % 20000))
   ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" "$@" > "$log" 2>&1 || true
 }
+# farm_sim holds its clock for 3 wall s (start_delay) while the recorder discovers its topics, so the bag holds the
+# simulation from its first message as the runner sees it. A bag that started 4.5 s late (the recorder polls the
+# master once a second, 10 simulated s at rate 10) gave the trackers fewer fixes before the first ambiguous person;
+# one association decided differently made graph and runner diverge for minutes.
 cat > "$WORK/record.launch" <<EOF
 <launch>
   <include file="\$(find picker_localisation)/launch/farm_sim.launch">
@@ -48,6 +52,7 @@ cat > "$WORK/record.launch" <<EOF
     <arg name="rate_factor" value="${RATE:-10}"/>
     <arg name="seed" value="$SEED"/>
     <arg name="required" value="true"/>
+    <arg name="start_delay" value="3"/>
   </include>
   <include file="\$(find picker_localisation)/launch/record.launch">
     <arg name="bag" value="$WORK/gnss.bag"/>

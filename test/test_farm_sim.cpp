@@ -27,6 +27,7 @@ struct Recorder {
   std::mutex mutex;
   std::map<std::string, int> counts;
   std::map<std::string, geometry_msgs::PoseStamped> last_pose;
+  std::map<std::string, double> first_stamp;
   std::vector<ros::Subscriber> subs;
   sensor_msgs::LaserScan last_scan;
   sensor_msgs::NavSatFix last_fix;
@@ -45,6 +46,7 @@ struct Recorder {
           std::lock_guard<std::mutex> l(mutex);
           ++counts[topic];
           last_pose[topic] = *m;
+          first_stamp.emplace(topic, m->header.stamp.toSec());
         }));
   }
   int get(const std::string& topic) {
@@ -92,6 +94,14 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   ASSERT_TRUE(waitFor([&] { return (ros::Time::now() - t0).toSec() > 10.0; }, 30.0))
       << "/clock does not advance";
   const ros::Time t1 = ros::Time::now();
+
+  // The clock waited at start_time (100 s) for start_delay (farm_sim.test: 5 wall s), so this node, subscribed
+  // by then, got the simulation from its first messages (ground truth at 10 Hz: 100.1 s).
+  {
+    std::lock_guard<std::mutex> l(rec.mutex);
+    ASSERT_TRUE(rec.first_stamp.count("/robot_1/ground_truth"));
+    EXPECT_LE(rec.first_stamp["/robot_1/ground_truth"], 100.25);
+  }
 
   // Every topic published at roughly its simulated rate during those 10 s.
   EXPECT_GE(rec.get("/robot_1/scan_front"), 60);  // 10 Hz

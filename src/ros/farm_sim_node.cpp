@@ -102,14 +102,18 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
   core::readOption(y, c, "duration", o.duration);
   core::readOption(y, c, "clock_step", o.clock_step);
   core::readOption(y, c, "start_time", o.start_time);
+  core::readOption(y, c, "start_delay", o.start_delay);
   core::readOption(y, c, "ground_truth_rate", o.ground_truth_rate);
   core::readOption(y, c, "publish_sensor_frames", o.publish_sensor_frames);
   core::readOption(y, c, "map_frame", o.map_frame);
-  static const std::vector<std::string> known{
-        "sim_config",   "urdf_template", "pickers_file", "datum_file",   "datum_source",     "seed",
-        "robots",       "robot_speed",   "patrol",       "enable_gnss",  "enable_laser",     "enable_rfid",
-        "enable_uwb",   "enable_camera", "rate_factor",  "duration",     "clock_step",       "start_time",
-        "ground_truth_rate", "publish_sensor_frames", "map_frame", "map_file", "map_topic"};
+  static const std::vector<std::string> known{"sim_config",  "urdf_template",     "pickers_file",
+                                              "datum_file",  "datum_source",      "seed",
+                                              "robots",      "robot_speed",       "patrol",
+                                              "enable_gnss", "enable_laser",      "enable_rfid",
+                                              "enable_uwb",  "enable_camera",     "rate_factor",
+                                              "duration",    "clock_step",        "start_time",
+                                              "start_delay", "ground_truth_rate", "publish_sensor_frames",
+                                              "map_frame",   "map_file",          "map_topic"};
   return core::checkOptions(o, y, known, c, unknown);
 }
 
@@ -122,6 +126,8 @@ std::string FarmSimOptions::validate() const {
   if (!(duration >= 0.0)) return bad("duration", duration, ">= 0 (0: forever)");
   if (!(clock_step > 0.0) || !std::isfinite(clock_step)) return bad("clock_step", clock_step, "finite and > 0");
   if (!(start_time > 0.0) || !std::isfinite(start_time)) return bad("start_time", start_time, "finite and > 0");
+  if (!(start_delay >= 0.0) || !std::isfinite(start_delay))
+    return bad("start_delay", start_delay, "finite and >= 0");
   if (!(ground_truth_rate > 0.0)) return bad("ground_truth_rate", ground_truth_rate, "> 0");
   if (datum_source != "auto" && datum_source != "file" && datum_source != "map")
     return "datum_source = " + datum_source + ": must be auto, file or map";
@@ -162,6 +168,7 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   duration_ = o.duration;
   clock_step_ = o.clock_step;
   start_time_ = o.start_time;
+  start_delay_ = o.start_delay;
   truth_rate_ = o.ground_truth_rate;
   publish_sensor_frames_ = o.publish_sensor_frames;
   map_frame_ = o.map_frame;
@@ -390,14 +397,19 @@ void FarmSimNode::tick() {
 
 void FarmSimNode::run() {
   if (!ok()) return;
-  wall_start_ = ros::WallTime::now();
-  // Let subscribers connect before time starts moving (wall time: the clock is ours).
-  {
-    rosgraph_msgs::Clock clock;
-    clock.clock = toRos(0.0);
-    clock_pub_.publish(clock);
-  }
+  // Let subscribers connect before time starts moving (wall time: the clock is ours). The clock is repeated
+  // while it waits: nodes on simulated time (rosbag record among them) start only once they have heard it.
+  rosgraph_msgs::Clock clock;
+  clock.clock = toRos(0.0);
+  clock_pub_.publish(clock);
   publishStaticFrames();
+  for (const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(start_delay_);
+       ros::ok() && ros::WallTime::now() < until;) {
+    ros::WallDuration(0.05).sleep();
+    clock_pub_.publish(clock);
+    ros::spinOnce();
+  }
+  wall_start_ = ros::WallTime::now();
   while (ros::ok() && (duration_ <= 0.0 || sim_->time() < duration_ - 1e-9)) {
     tick();
     ros::spinOnce();

@@ -39,6 +39,8 @@ struct FarmSimOptions {
   double duration = 0.0;      // simulated s, then the node exits (0: forever)
   double clock_step = 0.02;   // simulated s per tick
   double start_time = 100.0;  // ROS time of simulated t = 0, s
+  double start_delay = 0.0;   // wall s the clock stays at start_time before moving, so that subscribers (a
+                              // recorder discovering topics by regex polls the master once a second) connect
   double ground_truth_rate = 10.0;  // Hz
   bool publish_sensor_frames = true;
   std::string map_frame = "map";
@@ -80,7 +82,8 @@ class FarmSimNode {
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::unique_ptr<sim::FarmSimulator> sim_;
   core::PickerRegistry registry_;
-  double start_time_ = 100.0, rate_factor_ = 10.0, duration_ = 0.0, clock_step_ = 0.02, truth_rate_ = 10.0;
+  double start_time_ = 100.0, start_delay_ = 0.0, rate_factor_ = 10.0, duration_ = 0.0, clock_step_ = 0.02,
+         truth_rate_ = 10.0;
   double last_truth_ = -1e9;
   std::string map_frame_ = "map";
   ros::Publisher clock_pub_;
