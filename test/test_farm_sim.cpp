@@ -95,8 +95,8 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
       << "/clock does not advance";
   const ros::Time t1 = ros::Time::now();
 
-  // The clock waited at start_time (100 s) for start_delay (farm_sim.test: 5 wall s), so this node, subscribed
-  // by then, got the simulation from its first messages (ground truth at 10 Hz: 100.1 s).
+  // The clock waited at start_time (100 s) for start_delay (farm_sim.test: 5 wall s), so this node,
+  // subscribed by then, got the simulation from its first messages (ground truth at 10 Hz: 100.1 s).
   {
     std::lock_guard<std::mutex> l(rec.mutex);
     ASSERT_TRUE(rec.first_stamp.count("/robot_1/ground_truth"));
