@@ -40,8 +40,8 @@ own_master() {  # log args...
   ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" "$@" > "$log" 2>&1 || true
 }
 # farm_sim holds its clock for 3 wall s (start_delay) while the recorder discovers its topics, so the bag holds the
-# simulation from its first message as the runner sees it. A bag that started 4.5 s late (the recorder polls the
-# master once a second, 10 simulated s at rate 10) gave the trackers fewer fixes before the first ambiguous person;
+# simulation from its first message as the runner sees it. A bag that started 4.5 s late (the recorder waits to hear
+# the clock, then finds the topics; 10 simulated s per wall s at rate 10) gave the trackers fewer fixes before the first ambiguous person;
 # one association decided differently made graph and runner diverge for minutes.
 cat > "$WORK/record.launch" <<EOF
 <launch>

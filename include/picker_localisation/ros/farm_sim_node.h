@@ -39,8 +39,8 @@ struct FarmSimOptions {
   double duration = 0.0;      // simulated s, then the node exits (0: forever)
   double clock_step = 0.02;   // simulated s per tick
   double start_time = 100.0;  // ROS time of simulated t = 0, s
-  double start_delay = 0.0;   // wall s the clock stays at start_time before moving, so that subscribers (a
-                              // recorder discovering topics by regex polls the master once a second) connect
+  double start_delay = 0.0;   // wall s the clock stays at start_time (repeated) before moving, so that nodes on
+                              // simulated time (rosbag record waits to hear the clock) start and subscribe
   double ground_truth_rate = 10.0;  // Hz
   bool publish_sensor_frames = true;
   std::string map_frame = "map";
