@@ -9,6 +9,10 @@
 #include "nbs_test_maps.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/LU>
+
 using namespace picker_localisation;
 using namespace picker_localisation::nbs;
 using nbs_test::wideTunnels;
@@ -214,4 +218,130 @@ TEST(EstimatedNodePolicy, GoesToTheMapNodeOrTheNearestUnclaimedOne) {
   const PlanResult none = planner.plan(robot, 1.0, {&empty});
   EXPECT_FALSE(none.ok());
   EXPECT_FALSE(none.problem.empty());
+}
+
+// The lane check (issue "Find the lane"): a picker whose belief sits confidently on one node has no entropy
+// to lose, but when its GNSS bias is uncertain the truth may be a lane or two off. The gain of a stop is
+// p_detect * P(in view of the stop, belief blurred by the bias covariance) * lane entropy of the blurred
+// belief. Expected values computed here from the definition in the header, node by node.
+TEST(NbsPlanner, LaneCheckValuesASightingOfAPickerWithAnUncertainBias) {
+  auto map = wideTunnels();
+  const NodeIndex a = laneNode(*map, 2, 5);
+  StaticBeliefSource picker("p", uniformOver(*map, {a}));
+  Eigen::Matrix2d cov;
+  cov << 25.0, 3.0, 3.0, 16.0;  // m^2, spreads the truth over lanes 1-3 (8 m apart)
+  picker.setBiasCovariance(cov);
+  PlannerConfig cfg;
+  EXPECT_EQ(cfg.lane_check.weight, 0.0);  // off by default (measured, docs/readme/nbs.md "Lane check")
+  cfg.lane_check.weight = 1.0;
+  const PlanResult r = NextBestSensePlanner(map, cfg).plan(a, 1.0, {&picker});
+  ASSERT_TRUE(r.ok()) << r.problem;
+
+  // The belief blurred by a covariance, by the definition: Gaussian weights (covariance + 0.01 I) over the
+  // nodes within 3 sigma of a, normalised; and the entropy of its lane masses.
+  auto blurred = [&](const Eigen::Matrix2d& c) {
+    const Eigen::Matrix2d s = c + 0.01 * Eigen::Matrix2d::Identity();
+    const double largest = 0.5 * (c(0, 0) + c(1, 1)) +
+                           std::sqrt(0.25 * (c(0, 0) - c(1, 1)) * (c(0, 0) - c(1, 1)) + c(0, 1) * c(0, 1));
+    const double radius = 3.0 * std::sqrt(largest + 0.01);
+    std::vector<double> t(map->numNodes(), 0.0);
+    double z = 0.0;
+    for (std::size_t m = 0; m < map->numNodes(); ++m) {
+      const Eigen::Vector2d d = map->position2d(static_cast<NodeIndex>(m)) - map->position2d(a);
+      if (d.norm() > radius) continue;
+      t[m] = std::exp(-0.5 * d.dot(s.inverse() * d));
+      z += t[m];
+    }
+    for (double& v : t) v /= z;
+    return t;
+  };
+  auto laneMasses = [&](const std::vector<double>& t) {
+    std::vector<double> lanes(map->numLanes() + 1, 0.0);
+    for (std::size_t m = 0; m < t.size(); ++m) {
+      const auto l = map->lane(static_cast<NodeIndex>(m));
+      lanes[l == topology::kNoLane ? map->numLanes() : static_cast<std::size_t>(l)] += t[m];
+    }
+    return lanes;
+  };
+  auto laneEntropy = [&](const std::vector<double>& t) {
+    double h = 0.0;
+    for (double p : laneMasses(t))
+      if (p > 0.0) h -= p * std::log(p);
+    return h;
+  };
+  const std::vector<double> t = blurred(cov);
+  // After a sighting (R = 0.5^2 I): S' = (S^-1 + R^-1)^-1.
+  const Eigen::Matrix2d after =
+      (cov.inverse() + Eigen::Matrix2d::Identity() / std::pow(cfg.lane_check.sighting_std, 2)).inverse();
+  const double h_before = laneEntropy(t), h_after = laneEntropy(blurred(after));
+  EXPECT_GT(h_before, 0.5);          // the truth is spread over several lanes
+  EXPECT_LT(h_after, 0.01);          // a sighting names the lane (0.5 m against lanes 8 m apart)
+  EXPECT_GT(laneMasses(t)[2], 0.5);  // most of it still in the belief's lane
+  auto gainAt = [&](NodeIndex c) {
+    double in_view = 0.0;
+    for (std::size_t m = 0; m < t.size(); ++m)
+      if (map->lane(static_cast<NodeIndex>(m)) == map->lane(c) &&
+          map->distance(static_cast<NodeIndex>(m), c) <= cfg.lane_check.view_range + 1e-9)
+        in_view += t[m];
+    return cfg.lane_check.p_detect * in_view * (h_before - h_after);
+  };
+  // The belief is certain: no RFID gain, so rfid_gain is the lane gain alone.
+  for (NodeIndex c : {a, laneNode(*map, 1, 5), laneNode(*map, 3, 2), laneNode(*map, 0, 5)}) {
+    const Candidate* cand = find(r, c);
+    ASSERT_NE(cand, nullptr);
+    EXPECT_NEAR(cand->raw[kRfidGain], gainAt(c), 1e-9) << map->node(c).name;
+  }
+  EXPECT_GT(find(r, laneNode(*map, 1, 5))->raw[kRfidGain], 0.0);  // a neighbouring lane may be the true one
+  EXPECT_DOUBLE_EQ(find(r, *map->index("H2"))->raw[kRfidGain], 0.0);  // a headland node sees no lane
+  EXPECT_EQ(r.ranked.front().target_picker, "p");
+
+  // A fresh bias (1 cm) or lane_check off: a certain belief gives nothing anywhere.
+  picker.setBiasCovariance(1e-5 * Eigen::Matrix2d::Identity());
+  for (const Candidate& c : NextBestSensePlanner(map, cfg).plan(a, 1.0, {&picker}).ranked)
+    EXPECT_DOUBLE_EQ(c.raw[kRfidGain], 0.0) << map->node(c.node).name;
+  picker.setBiasCovariance(cov);
+  cfg.lane_check.weight = 0.0;
+  for (const Candidate& c : NextBestSensePlanner(map, cfg).plan(a, 1.0, {&picker}).ranked)
+    EXPECT_DOUBLE_EQ(c.raw[kRfidGain], 0.0) << map->node(c.node).name;
+}
+
+// Two pickers, both believed on one node, mirrored about the robot: the one whose bias is old is the one to
+// see.
+TEST(NbsPlanner, LaneCheckSendsTheRobotToThePickerWithTheOldBias) {
+  auto map = wideTunnels();
+  StaticBeliefSource fresh("fresh", uniformOver(*map, {laneNode(*map, 0, 5)}));
+  StaticBeliefSource old("old", uniformOver(*map, {laneNode(*map, 4, 5)}));
+  fresh.setBiasCovariance(0.04 * Eigen::Matrix2d::Identity());  // sighted a moment ago
+  old.setBiasCovariance(16.0 * Eigen::Matrix2d::Identity());    // never sighted
+  const NodeIndex robot = *map->index("H2");
+  PlannerConfig cfg;
+  cfg.lane_check.weight = 1.0;
+  const PlanResult r = NextBestSensePlanner(map, cfg).plan(robot, 1.0, {&fresh, &old});
+  ASSERT_TRUE(r.ok()) << r.problem;
+  EXPECT_EQ(r.ranked.front().target_picker, "old");
+  EXPECT_LE(std::abs(map->lane(r.ranked.front().node) - map->lane(laneNode(*map, 4, 0))), 1)
+      << map->node(r.ranked.front().node).name;
+  // Swap the ages: the goal follows.
+  fresh.setBiasCovariance(16.0 * Eigen::Matrix2d::Identity());
+  old.setBiasCovariance(0.04 * Eigen::Matrix2d::Identity());
+  const PlanResult swapped = NextBestSensePlanner(map, cfg).plan(robot, 1.0, {&fresh, &old});
+  ASSERT_TRUE(swapped.ok());
+  EXPECT_EQ(swapped.ranked.front().target_picker, "fresh");
+}
+
+TEST(NbsPlanner, LaneCheckOptionsFromYaml) {
+  std::vector<std::string> unknown;
+  const PlannerConfig c = PlannerConfig::fromYaml(
+      YAML::Load("lane_check: {weight: 0.5, view_range: 6.0, p_detect: 0.4, sighting_std: 0.3, range: 3}"),
+      &unknown);
+  EXPECT_DOUBLE_EQ(c.lane_check.weight, 0.5);
+  EXPECT_DOUBLE_EQ(c.lane_check.view_range, 6.0);
+  EXPECT_DOUBLE_EQ(c.lane_check.p_detect, 0.4);
+  EXPECT_DOUBLE_EQ(c.lane_check.sighting_std, 0.3);
+  ASSERT_EQ(unknown.size(), 1u);
+  EXPECT_NE(unknown[0].find("range"), std::string::npos);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("lane_check: {weight: -1}")), std::runtime_error);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("lane_check: {view_range: 0}")), std::runtime_error);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("lane_check: {p_detect: 1.5}")), std::runtime_error);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("lane_check: {sighting_std: 0}")), std::runtime_error);
 }

@@ -9,13 +9,14 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
-#include <ros/topic.h>
 #include <picker_localisation/GetCandidates.h>
+#include <picker_localisation/GnssBias.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/PickerBeliefArray.h>
 #include <picker_localisation/PickerList.h>
 #include <picker_localisation/WhatIf.h>
+#include <ros/topic.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <atomic>
@@ -214,6 +215,44 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
       10.0))
       << "robot_1 stopped planning after a bad belief";
 
+  // Bad input: a GNSS bias whose covariance is not a covariance (NaN, then asymmetric) is counted and
+  // ignored, a valid one is taken (robot_1's lane check reads it), planning goes on.
+  ros::Publisher bias_pub = nh.advertise<picker_localisation::GnssBias>("/pickers/picker_1/gnss_bias", 5);
+  ASSERT_TRUE(waitFor([&] { return bias_pub.getNumSubscribers() >= 1; }, 10.0))
+      << "robot_1 (policy nbs, lane_check on) does not subscribe to /pickers/picker_1/gnss_bias";
+  picker_localisation::GnssBias bias;
+  bias.picker_id = "picker_1";
+  bias.covariance = {std::nan(""), 0.0, 0.0, 1.0};
+  bias_pub.publish(bias);
+  bias.covariance = {4.0, 1.0, -1.0, 4.0};
+  bias_pub.publish(bias);
+  bias.covariance = {4.0, 0.5, 0.5, 3.0};
+  bias_pub.publish(bias);
+  auto diagnosticValue = [](const std::string& robot, const std::string& key) {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    auto it = g_diagnostics.find(robot);
+    if (it == g_diagnostics.end()) return std::string();
+    for (const auto& kv : it->second.values)
+      if (kv.key == key) return kv.value;
+    return std::string();
+  };
+  ASSERT_TRUE(waitFor(
+      [&] {
+        return diagnosticValue("robot_1", "gnss biases rejected picker_1") == "2" &&
+               diagnosticValue("robot_1", "gnss biases received picker_1") == "1";
+      },
+      15.0))
+      << "robot_1 diagnostics: rejected '" << diagnosticValue("robot_1", "gnss biases rejected picker_1")
+      << "', received '" << diagnosticValue("robot_1", "gnss biases received picker_1") << "'";
+  const ros::Time after_bias = ros::Time::now();
+  ASSERT_TRUE(waitFor(
+      [&] {
+        std::lock_guard<std::mutex> lock(g_mutex);
+        return g_goals.at("robot_1").header.stamp > after_bias;
+      },
+      10.0))
+      << "robot_1 stopped planning after a bad GNSS bias";
+
   // Missing tf: robot_4 publishes no goal and reports the missing pose.
   std::lock_guard<std::mutex> lock(g_mutex);
   EXPECT_EQ(g_goals.count("robot_4"), 0u);
@@ -269,7 +308,8 @@ TEST(NbsPlannerNode, StaleRobotPoseStopsPlanning) {
   EXPECT_TRUE(counted);
 }
 
-// The planner may only read beliefs, goals, the battery, tf and the clock: never a ground-truth topic.
+// The planner may only read beliefs, the GNSS bias estimates (gnss_ingest's, lane check), goals, the battery,
+// tf and the clock: never a ground-truth topic.
 TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
   XmlRpc::XmlRpcValue args, result, payload;
   args[0] = ros::this_node::getName();
@@ -294,6 +334,7 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
       EXPECT_EQ(t.find("ground_truth"), std::string::npos) << node << " subscribes to " << t;
       const bool allowed =
           (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
+          (t.rfind("/pickers/", 0) == 0 && t.size() > 10 && t.substr(t.size() - 10) == "/gnss_bias") ||
           t == "/pickers/beliefs" || t == "/pickers/registry" ||
           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
           t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");

@@ -507,7 +507,11 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
 #if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
     if (planner && (simulator.robot(0).atGoal() || now - last_plan >= replan_period)) {
       std::vector<nbs::BeliefSource*> views;
-      for (auto& s : sources) views.push_back(s.get());
+      for (std::size_t i = 0; i < sources.size(); ++i) {
+        // The bias covariance gnss_ingest publishes (GnssBias.covariance), as the nbs_planner node reads it.
+        if (tracks[i].gnss) sources[i]->setBiasCovariance(tracks[i].gnss->bias().appliedCovariance(now));
+        views.push_back(sources[i].get());
+      }
       const nbs::PlanResult plan = planner->plan(simulator.robot(0).currentNode(), battery_level, views);
       if (plan.ok()) simulator.setRobotGoal(0, plan.ranked.front().node);
       last_plan = now;

@@ -19,7 +19,8 @@
 //                               read_range of c, no read L(n) = 1 - p_detect within read_range and 1
 //                               elsewhere; P_k(read) = p_detect * b_k(read region). w_k = 1, or
 //                               claimed_picker_weight when another robot of higher priority already serves
-//                               picker k.
+//                               picker k. Plus the lane check (lane_check/weight > 0, issue "Find the
+//                               lane"): sum_k w_k weight P_k(seen at c) H_lane(t_k), see LaneCheckModel.
 //  battery [fraction], benefit: expected battery level after driving to c and sensing there (EnergyModel).
 // Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m
 // metres, minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them),
@@ -77,6 +78,29 @@ struct LidarSensingModel {
   double p_detect = 0.6;    // probability that a picker in view is seen and identified during the stop
 };
 
+// The lane check (issue "Find the lane"): what a stop at c would tell us about the *lane* of each picker by a
+// same-lane LiDAR sighting, which corrects the picker's GNSS bias. The entropy of the belief cannot value it:
+// a belief built from biased fixes sits confidently, and wrongly, in one lane. So the belief b_k is first
+// blurred by the bias covariance S_k (BeliefSource::biasCovariance): t_k(m) = sum_n b_k(n) N(x_m - x_n; 0,
+// S_k) / Z_n (Z_n normalises over the nodes within 3 sigma of n), where the picker truly is if the whole
+// belief may be off by the bias. H_lane(t) is the entropy of t's lane masses (nodes outside every lane form
+// one more class): large for a picker never sighted or sighted long ago, or whose belief is split between
+// lanes. A sighting leaves the bias with the Kalman posterior S'_k = S_k - S_k (S_k + R)^-1 S_k, R =
+// sighting_std^2 I, and t'_k the belief blurred by it. The expected gain of a stop at c is the expected lane
+// entropy removed:
+//   P_k(seen at c) max(0, H_lane(t_k) - H_lane(t'_k)),  P_k(seen at c) = p_detect t_k(nodes of c's lane
+//   within view_range of c),
+// in nats, added (times weight and w_k) to the rfid_gain criterion: ~0 for a picker sighted a moment ago (so
+// a fresh picker does not pull the robot into a neighbouring lane). A miss is counted as no information (the
+// leg tracker reports no negative evidence). Candidates outside every lane see nobody.
+struct LaneCheckModel {
+  double weight = 0.0;  // multiplies the lane gain in rfid_gain; 0 = off (the paper's criterion), as measured
+                        // (docs/readme/nbs.md "Lane check": no gain on navigation or three pickers)
+  double view_range = 8.0;  // m along the candidate's lane within which a picker is seen (leg_detector range)
+  double p_detect = 0.6;    // probability that a picker in view is seen and associated during the stop
+  double sighting_std = 0.5;  // m per axis, error of one sighting as a bias measurement (gnss_ingest's R)
+};
+
 // Energy of driving and sensing (a Thorvald-size robot on a 48 V pack; see docs/readme/nbs.md):
 //   E = drive_energy_per_m * d + base_power * (d / speed + t_sense) + sensing_power * t_sense   [J]
 //   battery after = level - E / capacity.
@@ -105,6 +129,7 @@ struct PlannerConfig {
   double planning_latency = 0.0;  // s added to every arrival time (belief age at planning)
   RfidSensingModel rfid;
   LidarSensingModel lidar;
+  LaneCheckModel lane_check;
   EnergyModel energy;
   double claimed_picker_weight = 0.0;  // w_k of a picker served by a higher-priority robot
   int claim_exclusion_hops = 0;        // nodes within this many hops of a claimed goal are excluded too
@@ -115,7 +140,8 @@ struct PlannerConfig {
 
   // Keys as config/nbs.yaml (missing keys keep the defaults). Throws std::runtime_error naming the key. With
   // `unknown`, one message per key that is neither the planner's (yamlKeys(), and the sub-keys of weights,
-  // rfid, lidar, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest known key.
+  // rfid, lidar, lane_check, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest
+  // known key.
   static PlannerConfig fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static PlannerConfig fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
   static const std::vector<std::string>& yamlKeys();
