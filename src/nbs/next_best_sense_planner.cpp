@@ -213,20 +213,12 @@ std::string PlannerConfig::validate() const {
 }
 
 const std::vector<std::string>& PlannerConfig::yamlKeys() {
-  static const std::vector<std::string> keys = {"policy",
-                                                "weights",
-                                                "interactions",
-                                                "horizon_hops",
-                                                "horizon_m",
-                                                "horizon_bucket",
-                                                "planning_latency",
-                                                "rfid",
-                                                "lidar",
-                                                "lane_check",
-                                                "energy",
-                                                "claimed_picker_weight",
-                                                "claim_exclusion_hops",
-                                                "target_picker"};
+  // Kept in rows (clang-format would put one key per line).
+  // clang-format off
+  static const std::vector<std::string> keys = {
+      "policy", "weights", "interactions", "horizon_hops", "horizon_m", "horizon_bucket", "planning_latency", "rfid",
+      "lidar", "lane_check", "energy", "claimed_picker_weight", "claim_exclusion_hops", "target_picker"};
+  // clang-format on
   return keys;
 }
 

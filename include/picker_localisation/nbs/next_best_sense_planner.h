@@ -20,7 +20,8 @@
 //                               elsewhere; P_k(read) = p_detect * b_k(read region). w_k = 1, or
 //                               claimed_picker_weight when another robot of higher priority already serves
 //                               picker k. Plus the lane check (lane_check/weight > 0, issue "Find the
-//                               lane"): sum_k w_k weight P_k(seen at c) H_lane(t_k), see LaneCheckModel.
+//                               lane"): sum_k w_k weight P_k(seen at c) (H_lane(t_k) - H_lane(t'_k)), see
+//                               LaneCheckModel.
 //  battery [fraction], benefit: expected battery level after driving to c and sensing there (EnergyModel).
 // Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m
 // metres, minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them),
