@@ -25,7 +25,7 @@ target_include_directories(test_camera_detector_node SYSTEM PRIVATE ${OpenCV_INC
 # Offline tools: CSV headers and rows on real data, usage errors.
 add_test(NAME vision_tools_cli
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/test/check_vision_tools.sh $<TARGET_FILE:bag_detect_legs>
-          $<TARGET_FILE:detect_people> ${CMAKE_CURRENT_SOURCE_DIR} ${PL_SHARED_DATA})
+          $<TARGET_FILE:detect_people> ${CMAKE_CURRENT_SOURCE_DIR} ${PL_TEST_DATA})
 add_dependencies(tests bag_detect_legs detect_people)
 # rostest: the leg_detector node and the offline runner's LegPipeline give identical observations (issue 16).
 if(TARGET picker_localisation_experiment)

@@ -24,13 +24,18 @@ struct CameraDetectorRig {
     image_pub = nh.advertise<sensor_msgs::Image>("image", 5);
     info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 1, true);
   }
-  // True once camera_detector subscribes to the images and publishes detections (within `seconds`).
-  bool connected(double seconds) {
-    return waitFor([this] { return image_pub.getNumSubscribers() > 0 && detections_sub.getNumPublishers() > 0; },
-                   seconds);
+  // True once camera_detector subscribes to the images and the CameraInfo and publishes detections (within
+  // `seconds`): a CameraInfo published after that goes over an open connection.
+  bool connected(double seconds = kDeadline) {
+    return waitFor(
+        [this] {
+          return image_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
+                 detections_sub.getNumPublishers() > 0;
+        },
+        seconds);
   }
   // Spins until `count` detection arrays have arrived (within `seconds`).
-  bool receivedAtLeast(std::size_t count, double seconds) {
+  bool receivedAtLeast(std::size_t count, double seconds = kDeadline) {
     return waitFor([this, count] { return received.size() >= count; }, seconds);
   }
 };

@@ -1,12 +1,18 @@
 #!/usr/bin/env bash
-# The installed package (cmake --install into a fresh prefix) is usable on its own: every launch file of the
-# install space loads (roslaunch --dump-params resolves every $(find ...), arg and included file there), the
-# nodes and scripts the launch files start are installed and executable, and rosrun finds a tool.
+# The installed package (cmake --install into a fresh prefix, or the install space of catkin_make install) is
+# usable on its own: every launch file of the install space loads (roslaunch --dump-params resolves every
+# $(find ...), arg and included file there), the nodes and scripts the launch files start are installed and
+# executable, and rosrun finds a tool.
+# usage: check_install.sh BUILD_DIR (installs it into a temporary prefix) | check_install.sh --prefix INSTALL_SPACE
 set -u
-build="$1"
-prefix="$(mktemp -d)"
-trap 'rm -rf "$prefix"' EXIT
-cmake --install "$build" --prefix "$prefix" > "$prefix.log" 2>&1 || { echo "FAIL: cmake --install"; tail -5 "$prefix.log"; exit 1; }
+if [ "$1" = "--prefix" ]; then
+  prefix="$2"
+else
+  build="$1"
+  prefix="$(mktemp -d)"
+  trap 'rm -rf "$prefix" "$prefix.log"' EXIT
+  cmake --install "$build" --prefix "$prefix" > "$prefix.log" 2>&1 || { echo "FAIL: cmake --install"; tail -5 "$prefix.log"; exit 1; }
+fi
 share="$prefix/share/picker_localisation"
 # Only the install space (no source tree, no devel space) on the package path.
 run() { env -i PATH=/usr/bin:/bin HOME="$prefix" ROS_HOME="$prefix/ros" ROS_PACKAGE_PATH="$prefix/share:/usr/share" \

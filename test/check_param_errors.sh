@@ -12,15 +12,38 @@ export ROS_HOME="${ROS_HOME:-$(mktemp -d)}"
 rosmaster --core -p "$port" > /dev/null 2>&1 &
 master=$!
 trap 'kill $master 2>/dev/null' EXIT
-for _ in $(seq 50); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done
+for _ in $(seq 300); do rosparam list > /dev/null 2>&1 && break; sleep 0.2; done  # up to a minute: a loaded machine
 fail=0
-# node args... : run for at most 15 s, print stdout+stderr, return the exit status (124: still running)
-# (its private parameters are deleted first: rosrun's _key:=value stays on the parameter server)
+# node args... : run until it exits, at most 60 s (a loaded machine), print stdout+stderr, return the exit status
+# (124: still running) (its private parameters are deleted first: rosrun's _key:=value stays on the parameter server)
 run() {
   local node="$1"; shift
   rosparam delete "/$node" > /dev/null 2>&1
-  timeout 15 rosrun picker_localisation "$node" "$@" 2>&1 | sed 's/\x1b\[[0-9;]*m//g'
+  timeout 60 rosrun picker_localisation "$node" "$@" 2>&1 | sed 's/\x1b\[[0-9;]*m//g'
   return "${PIPESTATUS[0]}"
+}
+# pattern node args... : run until `pattern` is in its output (at most 60 s: a loaded machine) and 5 s more, or until
+# it exits; print stdout+stderr, return the exit status (124: still running then; it is stopped)
+run_until() {
+  local pattern="$1" node="$2"; shift 2
+  local log pid rc=124
+  log="$(mktemp)"
+  rosparam delete "/$node" > /dev/null 2>&1
+  rosrun picker_localisation "$node" "$@" > "$log" 2>&1 &
+  pid=$!
+  for _ in $(seq 600); do
+    grep -q -- "$pattern" "$log" && { sleep 5; break; }
+    kill -0 "$pid" 2> /dev/null || break
+    sleep 0.1
+  done
+  if kill -0 "$pid" 2> /dev/null; then
+    kill "$pid"; wait "$pid" 2> /dev/null
+  else
+    wait "$pid"; rc=$?
+  fi
+  sed 's/\x1b\[[0-9;]*m//g' "$log"
+  rm -f "$log"
+  return $rc
 }
 common_gnss=(_pickers_file:="$pkg/config/pickers.yaml" _datum_file:="$pkg/config/datum.yaml" _map_file:="$map")
 common_tpf=(_pickers_file:="$pkg/config/pickers.yaml" _map_file:="$map" _tpf_params_file:="$pkg/config/tpf.yaml")
@@ -40,9 +63,9 @@ expect_fatal() { # node key value pattern args...
 expect_warning() { # node typo pattern args...
   local node="$1" typo="$2" pattern="$3"; shift 3
   local out rc
-  out="$(run "$node" "_$typo:=10" "$@")"; rc=$?
+  out="$(run_until "$pattern" "$node" "_$typo:=10" "$@")"; rc=$?
   if [ $rc -ne 124 ] || [ "$(printf '%s\n' "$out" | grep -c -- "$pattern")" -ne 1 ] || printf '%s' "$out" | grep -q FATAL; then
-    echo "FAIL: $node _$typo:=10: rc=$rc (want 124: still running after 15 s), want one line matching '$pattern':"
+    echo "FAIL: $node _$typo:=10: rc=$rc (want 124: still running 5 s after the warning), want one line matching '$pattern':"
     printf '%s\n' "$out" | tail -5
     fail=1
   else

@@ -4,7 +4,9 @@
 set -u
 out="${1:-$(mktemp --suffix=.png)}"
 launch="${2:-$(rospack find picker_localisation)/test/rviz_check.launch}"
-settle="${RVIZ_SETTLE:-12}"
+settle="${RVIZ_SETTLE:-12}"         # wall s before the first screenshot
+deadline="${RVIZ_DEADLINE:-60}"     # wall s for rviz to render at all (a loaded machine), retried every 2 s
+tries=$(( deadline > settle ? (deadline - settle) / 2 + 1 : 1 ))
 export PATH=/usr/bin:$PATH
 port=$((20000 + RANDOM % 20000))
 export ROS_MASTER_URI="http://localhost:$port" ROS_HOSTNAME=localhost
@@ -12,12 +14,18 @@ log="$(mktemp)"; alive="$(mktemp)"
 xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
   roslaunch -p $port '$launch' > '$log' 2>&1 &
   sleep $settle
-  import -window root '$out'
+  for _ in \$(seq $tries); do
+    import -window root '$out'
+    std=\$(convert '$out' -colorspace Gray -format '%[fx:standard_deviation]' info: 2>/dev/null)
+    colours=\$(convert '$out' -format '%k' info: 2>/dev/null)
+    awk -v s=\"\$std\" -v c=\"\$colours\" 'BEGIN{exit !(s > 0.05 && c > 50)}' && break
+    sleep 2
+  done
   pgrep -f 'rviz -d' >/dev/null && echo RVIZ_ALIVE > '$alive'
   rosnode kill -a >/dev/null 2>&1; sleep 1; kill %1 2>/dev/null; wait
 " >/dev/null 2>&1
 fail=0
-grep -q RVIZ_ALIVE "$alive" || { echo "FAIL: rviz is not running after ${settle} s"; fail=1; }
+grep -q RVIZ_ALIVE "$alive" || { echo "FAIL: rviz is not running (once rendered, or after ${deadline} s)"; fail=1; }
 if grep -E "PluginlibFactory: The plugin for class|Failed to load|ERROR" "$log" | grep -v -E "media_export|XDG_RUNTIME_DIR"; then
   echo "FAIL: errors in the rviz log above"; fail=1
 fi

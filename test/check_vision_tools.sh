@@ -1,11 +1,11 @@
 #!/bin/sh
 # The offline tools write the documented CSV headers and rows: bag_detect_legs on a real bag, detect_people on a
 # the first two frames of vtest.avi and on a folder of images (file names in the frame column); bad arguments exit with status 2.
-# usage: check_vision_tools.sh BAG_DETECT_LEGS DETECT_PEOPLE PACKAGE_DIR SHARED_DATA
+# usage: check_vision_tools.sh BAG_DETECT_LEGS DETECT_PEOPLE PACKAGE_DIR TEST_DATA
 set -e
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-"$1" --bag "$4/leg_tracker/rosbags/training_scans_res=0.33/positive_4_extracted.bag" --topic /training_scan \
+"$1" --bag "$4/leg_tracker/positive_4_extracted.bag" --topic /training_scan \
   --model "$3/config/leg_classifier.yml" --out "$tmp/legs.csv"
 [ "$(head -1 "$tmp/legs.csv")" = "stamp,x,y,confidence" ] || { echo "bad legs header"; exit 1; }
 rows=$(($(wc -l < "$tmp/legs.csv") - 1))
@@ -23,7 +23,7 @@ fi
 [ "$(head -1 "$tmp/video.csv")" = "frame,x,y,width,height,confidence" ] || { echo "bad people header"; exit 1; }
 [ "$(sed -n 2p "$tmp/video.csv" | cut -d, -f1)" = "0" ] || { echo "first video row is not frame 0"; exit 1; }
 # The recall vs false-legs curve of the labelled and the no-people recording: header and the seven thresholds.
-D="$4/leg_tracker/rosbags/training_scans_res=0.33"
+D="$4/leg_tracker"
 "$1" --curve --labelled "$D/positive_4_extracted.bag" --negatives "$D/negative_2.bag" --negatives-from 0.9 \
   --model "$3/config/leg_classifier.yml" > "$tmp/curve.md"
 grep -q "^| setting | leg_threshold | leg recall | precision | false legs / scan" "$tmp/curve.md" || { echo "no curve header"; cat "$tmp/curve.md"; exit 1; }

@@ -15,10 +15,14 @@
 
 namespace diagnostics_test {
 
+// Wall s a collection waits at most by default: generous, for a loaded machine (it returns as soon as every
+// expected node reported).
+constexpr double kDeadline = 60.0;
+
 // The statuses of each node (by its graph name, with the leading slash) seen within `wall_timeout` s; returns
 // early once every node in `expected` has reported.
 inline std::map<std::string, std::map<std::string, diagnostic_msgs::DiagnosticStatus>> collect(
-    ros::NodeHandle& nh, const std::set<std::string>& expected, double wall_timeout) {
+    ros::NodeHandle& nh, const std::set<std::string>& expected, double wall_timeout = kDeadline) {
   std::mutex mutex;
   std::map<std::string, std::map<std::string, diagnostic_msgs::DiagnosticStatus>> seen;
   ros::Subscriber sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(

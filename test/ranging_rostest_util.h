@@ -37,8 +37,12 @@ struct Collector {
   }
 };
 
+// Wall s a wait for something that must happen allows by default: generous, for a loaded machine (the wait
+// ends as soon as its condition holds).
+constexpr double kDeadline = 60.0;
+
 // Spins until pred() or `seconds` (wall) have passed; returns pred().
-inline bool waitFor(const std::function<bool()>& pred, double seconds) {
+inline bool waitFor(const std::function<bool()>& pred, double seconds = kDeadline) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < end) {
     ros::spinOnce();

@@ -9,6 +9,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "legacy_tmap.h"
 #include "picker_localisation/eval/experiment.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
@@ -149,7 +150,7 @@ TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
   if (!methodUnavailableReason("khan_connected").empty())
     GTEST_SKIP() << methodUnavailableReason("khan_connected");
   auto map = std::make_shared<const topology::TopologicalMap>(
-      topology::loadMap(std::string(PL_SHARED_DATA) + "/topomaps/riseholme_sim.tmap"));
+      topology::loadMap(picker_localisation::test::legacyRiseholmePath()));
   RunConfig rc;
   rc.scenario = Scenario::kMulti;
   rc.method = "khan_connected";

@@ -55,9 +55,9 @@ struct Recorder {
   }
 };
 
-// Waits (wall time) until pred() or timeout.
+// Waits (wall time) until pred() or timeout (by default generous, for a loaded machine).
 template <class P>
-bool waitFor(P pred, double wall_timeout) {
+bool waitFor(P pred, double wall_timeout = 60.0) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(wall_timeout);
   while (ros::WallTime::now() < end) {
     if (pred()) return true;
@@ -116,10 +116,10 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   // tf: map -> robot_1/odom -> robot_1/base_link matches the robot's ground truth; sensor frames exist.
   tf2_ros::Buffer buffer;
   tf2_ros::TransformListener listener(buffer);
-  ASSERT_TRUE(waitFor([&] { return buffer.canTransform("map", "robot_1/base_link", ros::Time(0)); }, 10.0));
+  ASSERT_TRUE(waitFor([&] { return buffer.canTransform("map", "robot_1/base_link", ros::Time(0)); }));
   for (const char* f : {"robot_1/laser_front", "robot_1/laser_rear", "robot_1/uwb_anchor_1",
                         "robot_1/camera_1", "robot_1/rfid_left"})
-    EXPECT_TRUE(waitFor([&] { return buffer.canTransform("robot_1/base_link", f, ros::Time(0)); }, 5.0)) << f;
+    EXPECT_TRUE(waitFor([&] { return buffer.canTransform("robot_1/base_link", f, ros::Time(0)); })) << f;
   const auto laser = buffer.lookupTransform("robot_1/base_link", "robot_1/laser_front", ros::Time(0));
   EXPECT_NEAR(laser.transform.translation.x, 0.78, 1e-6);
   EXPECT_NEAR(laser.transform.translation.y, 0.73, 1e-6);
@@ -140,7 +140,7 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   picker_localisation::GoalNode bad;
   bad.robot_id = "robot_1";
   bad.node = "NoSuchNode";
-  ASSERT_TRUE(waitFor([&] { return goal_pub.getNumSubscribers() > 0; }, 10.0));
+  ASSERT_TRUE(waitFor([&] { return goal_pub.getNumSubscribers() > 0; }));
   goal_pub.publish(bad);
   ros::WallDuration(0.5).sleep();
   Eigen::Vector2d robot_pos;
@@ -158,13 +158,12 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
   good.node = "WayPoint1";
   goal_pub.publish(good);
   const ros::Time sent = ros::Time::now();
-  const bool arrived = waitFor(
-      [&] {
-        std::lock_guard<std::mutex> l(rec.mutex);
-        const auto& m = rec.last_pose["/robot_1/ground_truth"];
-        return (Eigen::Vector2d(m.pose.position.x, m.pose.position.y) - map.position2d(goal)).norm() < 0.05;
-      },
-      30.0);
+  // The default (generous) deadline: the simulation runs slower on a loaded machine.
+  const bool arrived = waitFor([&] {
+    std::lock_guard<std::mutex> l(rec.mutex);
+    const auto& m = rec.last_pose["/robot_1/ground_truth"];
+    return (Eigen::Vector2d(m.pose.position.x, m.pose.position.y) - map.position2d(goal)).norm() < 0.05;
+  });
   EXPECT_TRUE(arrived);
   // It took about the path length at 1 m/s of simulated time (not less).
   EXPECT_GE((ros::Time::now() - sent).toSec(), travel - 1.0);
@@ -173,7 +172,7 @@ TEST(FarmSim, ClockTfTopicsGroundTruthAndGoals) {
 
 TEST(FarmSim, PublishesDiagnostics) {
   ros::NodeHandle nh;
-  const auto seen = diagnostics_test::collect(nh, {"/farm_sim"}, 20.0);
+  const auto seen = diagnostics_test::collect(nh, {"/farm_sim"});
   ASSERT_TRUE(seen.count("/farm_sim"));
   EXPECT_TRUE(seen.at("/farm_sim").count("simulation"));
   EXPECT_TRUE(seen.at("/farm_sim").count("inputs"));  // goals

@@ -1,5 +1,5 @@
 // GnssIngest on the real fixes of robot_localization's test1.bag (989 NavSatFix of a Husky in a parking lot,
-// status SBAS, covariance type APPROXIMATED; see ../shared/data/robot_localization/README.md). Plain gtest with
+// status SBAS, covariance type APPROXIMATED; see test/data/README.md). Plain gtest with
 // the rosbag C++ API: no master. Datum near the bag's start.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
@@ -21,12 +21,12 @@ using picker_localisation::core::DatumConfig;
 using picker_localisation::core::GeodeticDatum;
 
 namespace {
-const std::string kBag = std::string(PL_SHARED_DATA) + "/robot_localization/test/test1.bag";
+const std::string kBag = std::string(PL_TEST_DATA) + "/robot_localization/test1.bag";
 
 }  // namespace
 
 TEST(GnssBag, RealFixesOfTest1Bag) {
-  if (!std::ifstream(kBag).good()) GTEST_SKIP() << "no " << kBag;
+  ASSERT_TRUE(std::ifstream(kBag).good()) << "no " << kBag;
   rosbag::Bag bag(kBag, rosbag::bagmode::Read);
   std::vector<sensor_msgs::NavSatFix> fixes;
   double odom_speed_sum = 0.0;
@@ -91,7 +91,7 @@ TEST(GnssBag, RealFixesOfTest1Bag) {
 }
 
 TEST(GnssBag, UtmDatumGivesTheSameTrack) {
-  if (!std::ifstream(kBag).good()) GTEST_SKIP() << "no " << kBag;
+  ASSERT_TRUE(std::ifstream(kBag).good()) << "no " << kBag;
   rosbag::Bag bag(kBag, rosbag::bagmode::Read);
   std::vector<sensor_msgs::NavSatFix> fixes;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/fix")))

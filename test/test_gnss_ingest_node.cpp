@@ -57,7 +57,7 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   f.position_covariance[0] = -1.0;
   send(p1, f);                                        // negative covariance
   send(p1, fixAt(datum, where, t0));                  // good
-  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }, 10.0));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 1; }));
   send(p1, fixAt(datum, where, t0));                                        // repeated stamp
   send(p1, fixAt(datum, where, t0 - ros::Duration(1.0)));                   // backwards
   send(p1, fixAt(datum, where, ros::Time(4102444800.0)));                   // 2100-01-01: far future, dropped
@@ -65,7 +65,7 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
     send(p1, fixAt(datum, where + Eigen::Vector2d(50000.0, 0.0), t0 + ros::Duration(0.1 * k)));
   send(p1, fixAt(datum, where + Eigen::Vector2d(0.5, 0.0), t0 + ros::Duration(1.0)));  // good again
   send(p2, fixAt(datum, Eigen::Vector2d(25.0, -30.0), t0 + ros::Duration(1.0)));       // other picker
-  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 3; }, 10.0));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.obs.size() >= 3; }));
   ranging_test::spinFor(0.5);
   ASSERT_EQ(c.obs.size(), 3u);
   EXPECT_EQ(ranging_test::countFor(c.obs, "picker_1"), 2u);
@@ -83,13 +83,11 @@ TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
   EXPECT_TRUE(c.obs[1].has_velocity);  // two fixes: 0.5 m in 1 s
   EXPECT_NEAR(c.obs[1].velocity.x, 0.5, 1e-3);
   // Diagnostics: rejections by kind (no_fix/not_finite/negative_cov/out_of_order/jump/off_map).
-  ASSERT_TRUE(ranging_test::waitFor(
-      [&] {
-        return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"] == "1/1/1/2/0/5" &&
-               c.diag["picker_1 accepted"] == "2";
-      },
-      5.0))
-      << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"];
+  ASSERT_TRUE(ranging_test::waitFor([&] {
+    return c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"] ==
+               "1/1/1/2/0/5" &&
+           c.diag["picker_1 accepted"] == "2";
+  })) << c.diag["picker_1 rejected no_fix/not_finite/negative_cov/out_of_order/jump/off_map"];
   EXPECT_EQ(c.diag["picker_1 accepted"], "2");  // the fix after the 2100 one was accepted: nothing blocked
   EXPECT_EQ(c.diag["fixes stamped in the future (rejected)"], "1");
 }
@@ -121,22 +119,27 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
     pl::core::setGaussianLikelihood(o, map, at, o.position_covariance);
     return pl::ros_adapter::toMsg(o, map);
   };
-  const ros::Time t0 = ros::Time::now();
-  for (int k = 0; k < 6; ++k) {
-    const ros::Time t = t0 + ros::Duration(k);
-    fixes.publish(fixAt(datum, truth + offset, t));
-    people.publish(person(truth, t + ros::Duration(0.1)));
-    ranging_test::spinFor(0.05);
-  }
-  // Far from every picker's prediction: nobody we track, not published (counted as "nobody's").
-  people.publish(person(Eigen::Vector2d(300.0, 300.0), t0 + ros::Duration(6.0)));
-  fixes.publish(fixAt(datum, truth + offset, t0 + ros::Duration(7.0)));
   auto lidar = [&](bool identifying) {
     std::size_t n = 0;
     for (const auto& o : c.obs) n += o.sensor == "lidar" && o.identifying == identifying;
     return n;
   };
-  ASSERT_TRUE(ranging_test::waitFor([&] { return lidar(true) >= 6 && bias.size() >= 7; }, 10.0))
+  // Each fix before its person and each person (its sighting) before the next fix: wait for the fix's bias
+  // message and the person's identified observation (a fixed pause could let them overtake each other).
+  const ros::Time t0 = ros::Time::now();
+  for (std::size_t k = 0; k < 6; ++k) {
+    const ros::Time t = t0 + ros::Duration(static_cast<double>(k));
+    fixes.publish(fixAt(datum, truth + offset, t));
+    ASSERT_TRUE(ranging_test::waitFor([&] { return bias.size() >= k + 1; }))
+        << "no bias message for fix " << k;
+    people.publish(person(truth, t + ros::Duration(0.1)));
+    ASSERT_TRUE(ranging_test::waitFor([&] { return lidar(true) >= k + 1; }))
+        << "person " << k << " not identified";
+  }
+  // Far from every picker's prediction: nobody we track, not published (counted as "nobody's").
+  people.publish(person(Eigen::Vector2d(300.0, 300.0), t0 + ros::Duration(6.0)));
+  fixes.publish(fixAt(datum, truth + offset, t0 + ros::Duration(7.0)));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return lidar(true) >= 6 && bias.size() >= 7; }))
       << lidar(true) << " identified, " << lidar(false) << " anonymous, " << bias.size() << " bias messages";
   EXPECT_EQ(lidar(true), 6u);
   EXPECT_EQ(lidar(false), 0u);
@@ -158,14 +161,11 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
   ASSERT_NE(fix, nullptr);
   EXPECT_NEAR(fix->position.x, truth.x(), 0.5);
   EXPECT_NEAR(fix->position.y, truth.y(), 0.5);
-  ASSERT_TRUE(ranging_test::waitFor(
-      [&] {
-        return c.diag["picker_3 bias sightings accepted/refused"].rfind("6/", 0) == 0 &&
-               c.diag["people received / identified / nobody's / malformed"] == "7 / 6 / 1 / 0";
-      },
-      5.0))
-      << c.diag["picker_3 bias sightings accepted/refused"] << "; people "
-      << c.diag["people received / identified / nobody's / malformed"];
+  ASSERT_TRUE(ranging_test::waitFor([&] {
+    return c.diag["picker_3 bias sightings accepted/refused"].rfind("6/", 0) == 0 &&
+           c.diag["people received / identified / nobody's / malformed"] == "7 / 6 / 1 / 0";
+  })) << c.diag["picker_3 bias sightings accepted/refused"]
+      << "; people " << c.diag["people received / identified / nobody's / malformed"];
 }
 
 // Issue "Drop-in on an LCAS robot": a picker position already in the map frame (PoseWithCovarianceStamped) is an
@@ -200,7 +200,7 @@ TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
       if (o.sensor == sensor) found = &o;
     return found;
   };
-  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("pose") != nullptr; }, 10.0)) << "no pose observation";
+  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("pose") != nullptr; })) << "no pose observation";
   const pl::Observation& o = *bySensor("pose");
   EXPECT_TRUE(o.identifying);
   EXPECT_EQ(o.picker_id, "picker_2");
@@ -209,7 +209,7 @@ TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
   for (std::size_t k = 1; k < o.likelihood.size(); ++k)
     if (o.likelihood[k] > o.likelihood[best]) best = k;
   EXPECT_EQ(o.nodes.at(best), map.node(node).name);
-  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["picker poses published / dropped"] == "1 / 1"; }, 5.0))
+  ASSERT_TRUE(ranging_test::waitFor([&] { return c.diag["picker poses published / dropped"] == "1 / 1"; }))
       << c.diag["picker poses published / dropped"];
 
   // picker_3's unit reads (3, 2) m off and its bias is known from the test before: a person of the other
@@ -227,7 +227,8 @@ TEST(GnssIngestNode, MapFramePosesAndOtherDetectorsPeople) {
   a.poses[1].position.x = 300.0;
   a.poses[1].position.y = 300.0;
   people.publish(a);
-  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("people") != nullptr; }, 10.0)) << "no people observation";
+  ASSERT_TRUE(ranging_test::waitFor([&] { return bySensor("people") != nullptr; }))
+      << "no people observation";
   EXPECT_TRUE(bySensor("people")->identifying);
   EXPECT_EQ(bySensor("people")->picker_id, "picker_3");
 }
@@ -260,11 +261,12 @@ TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
   EXPECT_GT(fix1.getNumSubscribers(), 0u);
   list.pickers.pop_back();
   registry.publish(list);
-  ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() > 0; }, 10.0)) << "picker_4 not subscribed";
+  ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() > 0; }))
+      << "picker_4 not subscribed";
   ranging_test::spinFor(0.3);
   const std::size_t before = c.obs.size();
   fix4.publish(fixAt(datum, Eigen::Vector2d(20.0, -20.0), ros::Time::now()));
-  ASSERT_TRUE(ranging_test::waitFor([&] { return ranging_test::countFor(c.obs, "picker_4") == 1; }, 10.0));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return ranging_test::countFor(c.obs, "picker_4") == 1; }));
   EXPECT_GT(c.obs.size(), before);
   // picker_2 and picker_3 are not in the list: no longer subscribed. An empty list removes everyone.
   ros::Publisher fix2 = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_2/fix", 20);
@@ -272,12 +274,13 @@ TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
   EXPECT_EQ(fix2.getNumSubscribers(), 0u);
   list.pickers.clear();
   registry.publish(list);
-  ASSERT_TRUE(ranging_test::waitFor([&] { return fix4.getNumSubscribers() == 0 && fix1.getNumSubscribers() == 0; }, 10.0));
+  ASSERT_TRUE(
+      ranging_test::waitFor([&] { return fix4.getNumSubscribers() == 0 && fix1.getNumSubscribers() == 0; }));
   // Back to the file's three pickers for any later test.
   list.pickers = {info("picker_1", "/pickers/picker_1/fix"), info("picker_2", "/pickers/picker_2/fix"),
                   info("picker_3", "/pickers/picker_3/fix")};
   registry.publish(list);
-  ASSERT_TRUE(ranging_test::waitFor([&] { return fix1.getNumSubscribers() > 0; }, 10.0));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return fix1.getNumSubscribers() > 0; }));
 }
 
 int main(int argc, char** argv) {

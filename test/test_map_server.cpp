@@ -50,7 +50,8 @@ TEST(MapServer, Service) {
 TEST(MapServer, Diagnostics) {
   bool found = false;
   for (int i = 0; i < 10 && !found; ++i) {
-    auto d = ros::topic::waitForMessage<diagnostic_msgs::DiagnosticArray>("/diagnostics", ros::Duration(5.0));
+    auto d =
+        ros::topic::waitForMessage<diagnostic_msgs::DiagnosticArray>("/diagnostics", ros::Duration(60.0));
     ASSERT_TRUE(d);
     for (const auto& s : d->status)
       if (s.name.find("topological map") != std::string::npos) {

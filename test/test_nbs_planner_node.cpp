@@ -98,7 +98,8 @@ void markerCallback(const visualization_msgs::MarkerArray::ConstPtr& m) {
     if (mk.type == visualization_msgs::Marker::SPHERE_LIST && !mk.points.empty()) g_markers = true;
 }
 
-bool waitFor(const std::function<bool()>& done, double seconds) {
+// Waits until done() or `seconds` of wall time (by default generous, for a loaded machine).
+bool waitFor(const std::function<bool()>& done, double seconds = 60.0) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < end) {
     if (done()) return true;
@@ -118,7 +119,7 @@ std::string diagnosticValue(const std::string& robot, const std::string& key) {
 }
 
 // True when `robot` publishes a goal stamped after now within `seconds` (its planner is still planning).
-bool plansAgain(const std::string& robot, double seconds) {
+bool plansAgain(const std::string& robot, double seconds = 60.0) {
   const ros::Time now = ros::Time::now();
   return waitFor(
       [&] {
@@ -147,9 +148,10 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
       60.0))
       << "goals received: " << g_goals.size() << ", markers: " << g_markers;
   // Goals keep coming every planning period; take fresh ones after the what-if has been used.
-  ASSERT_TRUE(waitFor([] { return g_what_if_calls.load() > 0; }, 20.0))
-      << "the planner never called the what-if";
-  ros::WallDuration(2.5).sleep();
+  ASSERT_TRUE(waitFor([] { return g_what_if_calls.load() > 0; })) << "the planner never called the what-if";
+  // Two planning periods later, however slow the machine: every robot planned twice more.
+  for (int round = 0; round < 2; ++round)
+    for (const std::string& r : robots) ASSERT_TRUE(plansAgain(r)) << r << " stopped planning";
   std::map<std::string, picker_localisation::GoalNode> goals;
   {
     std::lock_guard<std::mutex> lock(g_mutex);
@@ -178,7 +180,8 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   }
 
   // The goal as a PoseStamped too (navigation stacks that take a pose): exactly a node's pose, map frame.
-  auto pose = ros::topic::waitForMessage<geometry_msgs::PoseStamped>("/robot_1/goal_pose", nh, ros::Duration(10.0));
+  auto pose =
+      ros::topic::waitForMessage<geometry_msgs::PoseStamped>("/robot_1/goal_pose", nh, ros::Duration(60.0));
   ASSERT_TRUE(pose) << "no /robot_1/goal_pose";
   EXPECT_EQ(pose->header.frame_id, "map");
   const Eigen::Vector2d at(pose->pose.position.x, pose->pose.position.y);
@@ -186,7 +189,7 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
 
   // get_candidates: ranked, one normalised row of 4 criteria per node, all in [0, 1].
   ros::ServiceClient client = nh.serviceClient<picker_localisation::GetCandidates>("/robot_1/get_candidates");
-  ASSERT_TRUE(client.waitForExistence(ros::Duration(10.0)));
+  ASSERT_TRUE(client.waitForExistence(ros::Duration(60.0)));
   picker_localisation::GetCandidates srv;
   srv.request.max_candidates = 0;
   ASSERT_TRUE(client.call(srv));
@@ -216,19 +219,16 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
     g_fleet.beliefs.push_back(bad);
     g_fleet_pub.publish(g_fleet);
   }
-  ASSERT_TRUE(waitFor(
-      [] {
-        const std::string rejected = diagnosticValue("robot_1", "beliefs rejected picker_3");
-        return !rejected.empty() && rejected != "0";
-      },
-      15.0))
-      << "robot_1 diagnostics never counted the bad belief";
-  ASSERT_TRUE(plansAgain("robot_1", 10.0)) << "robot_1 stopped planning after a bad belief";
+  ASSERT_TRUE(waitFor([] {
+    const std::string rejected = diagnosticValue("robot_1", "beliefs rejected picker_3");
+    return !rejected.empty() && rejected != "0";
+  })) << "robot_1 diagnostics never counted the bad belief";
+  ASSERT_TRUE(plansAgain("robot_1")) << "robot_1 stopped planning after a bad belief";
 
   // Bad input: a GNSS bias whose covariance is not a covariance (NaN, then asymmetric) is counted and
   // ignored, a valid one is taken (robot_1's lane check reads it), planning goes on.
   ros::Publisher bias_pub = nh.advertise<picker_localisation::GnssBias>("/pickers/picker_1/gnss_bias", 5);
-  ASSERT_TRUE(waitFor([&] { return bias_pub.getNumSubscribers() >= 1; }, 10.0))
+  ASSERT_TRUE(waitFor([&] { return bias_pub.getNumSubscribers() >= 1; }))
       << "robot_1 (policy nbs, lane_check on) does not subscribe to /pickers/picker_1/gnss_bias";
   picker_localisation::GnssBias bias;
   bias.picker_id = "picker_1";
@@ -238,15 +238,13 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   bias_pub.publish(bias);
   bias.covariance = {4.0, 0.5, 0.5, 3.0};
   bias_pub.publish(bias);
-  ASSERT_TRUE(waitFor(
-      [&] {
-        return diagnosticValue("robot_1", "gnss biases rejected picker_1") == "2" &&
-               diagnosticValue("robot_1", "gnss biases received picker_1") == "1";
-      },
-      15.0))
-      << "robot_1 diagnostics: rejected '" << diagnosticValue("robot_1", "gnss biases rejected picker_1")
-      << "', received '" << diagnosticValue("robot_1", "gnss biases received picker_1") << "'";
-  ASSERT_TRUE(plansAgain("robot_1", 10.0)) << "robot_1 stopped planning after a bad GNSS bias";
+  ASSERT_TRUE(waitFor([&] {
+    return diagnosticValue("robot_1", "gnss biases rejected picker_1") == "2" &&
+           diagnosticValue("robot_1", "gnss biases received picker_1") == "1";
+  })) << "robot_1 diagnostics: rejected '"
+      << diagnosticValue("robot_1", "gnss biases rejected picker_1") << "', received '"
+      << diagnosticValue("robot_1", "gnss biases received picker_1") << "'";
+  ASSERT_TRUE(plansAgain("robot_1")) << "robot_1 stopped planning after a bad GNSS bias";
 
   // Missing tf: robot_4 publishes no goal and reports the missing pose.
   std::lock_guard<std::mutex> lock(g_mutex);
@@ -284,14 +282,11 @@ TEST(NbsPlannerNode, StaleRobotPoseStopsPlanning) {
       30.0))
       << "robot_5 never planned with a fresh pose";
   const ros::Time stopped = ros::Time::now();  // the localisation stops here
-  ASSERT_TRUE(waitFor(
-      [] {
-        std::lock_guard<std::mutex> lock(g_mutex);
-        auto it = g_diagnostics.find("robot_5");
-        return it != g_diagnostics.end() && it->second.message.find("s old") != std::string::npos;
-      },
-      15.0))
-      << "robot_5 never reported its stale pose";
+  ASSERT_TRUE(waitFor([] {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    auto it = g_diagnostics.find("robot_5");
+    return it != g_diagnostics.end() && it->second.message.find("s old") != std::string::npos;
+  })) << "robot_5 never reported its stale pose";
   ros::WallDuration(2.5).sleep();  // more than two planning periods after the report
   std::lock_guard<std::mutex> lock(g_mutex);
   EXPECT_LT(g_goals.at("robot_5").header.stamp.toSec(), stopped.toSec() + 1.5)
@@ -360,7 +355,7 @@ TEST(NbsPlannerNode, FollowsThePickerListOfTheTracker) {
       if (kv.key == key) return kv.value;
     return "";
   };
-  ASSERT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "0"; }, 15.0))
+  ASSERT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "0"; }))
       << "robot_1 never listed picker_9";
   EXPECT_EQ(value("robot_1", "beliefs received picker_3"), "") << "picker_3 left the list";
   {
@@ -368,7 +363,7 @@ TEST(NbsPlannerNode, FollowsThePickerListOfTheTracker) {
     g_fleet.beliefs.push_back(beliefMsg("picker_9", {g_confident_node}, {1.0}, g_confident_node));
     g_fleet_pub.publish(g_fleet);
   }
-  EXPECT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "1"; }, 15.0))
+  EXPECT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "1"; }))
       << "robot_1 counted " << value("robot_1", "beliefs received picker_9") << " beliefs of picker_9";
 }
 

@@ -12,6 +12,7 @@
 #include <numeric>
 #include <set>
 
+#include "legacy_tmap.h"
 #include "picker_localisation/sim/farm_simulator.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
@@ -22,7 +23,7 @@ using topology::NodeIndex;
 
 namespace {
 const std::string kTmap2 = std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2";
-const std::string kLegacy = std::string(PL_SHARED_DATA) + "/topomaps/riseholme_sim.tmap";
+const std::string kLegacy = picker_localisation::test::legacyRiseholmePath();  // one-way edges, chain lanes
 
 topology::TopologicalMap polytunnel(std::size_t lanes = 6, std::size_t per_lane = 8) {
   topology::PolytunnelSpec spec;

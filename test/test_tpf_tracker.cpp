@@ -76,8 +76,9 @@ class TrackerTest : public ::testing::Test {
       ros::WallDuration(0.01).sleep();
     }
   }
+  // Default deadline: generous, for a loaded machine (the wait ends as soon as pred() holds).
   template <typename Pred>
-  bool waitFor(Pred pred, double seconds = 10.0) {
+  bool waitFor(Pred pred, double seconds = 60.0) {
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(seconds);
     while (ros::WallTime::now() < until) {
       ros::spinOnce();
@@ -180,8 +181,8 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
 
   // 4. Periodic prediction (picker_1 at 2 Hz) without observations: newer stamps, same observation count.
   const double last_stamp = topics_["picker_1"].beliefs.back().header.stamp.toSec();
-  ASSERT_TRUE(waitFor(
-      [&] { return topics_["picker_1"].beliefs.back().header.stamp.toSec() > last_stamp + 0.4; }, 5.0));
+  ASSERT_TRUE(
+      waitFor([&] { return topics_["picker_1"].beliefs.back().header.stamp.toSec() > last_stamp + 0.4; }));
   EXPECT_EQ(topics_["picker_1"].beliefs.back().observations, b1.observations + 1);
 
   // 5. What-if: predict ahead, and posterior under a hypothetical observation at B; the live filter stays.
@@ -238,12 +239,17 @@ TEST_F(TrackerTest, BeliefEstimateRoutingServicesAndBadInput) {
         for (const auto& st : m->status)
           if (st.hardware_id == "picker_1") statuses.push_back(st);
       });
-  ASSERT_TRUE(waitFor([&] { return !statuses.empty(); }, 5.0));
+  ASSERT_TRUE(waitFor([&] { return !statuses.empty(); }));
   bool has_rejected = false, has_future = false;
-  for (const auto& kv : statuses.back().values) {
-    if (kv.key == "rejected (invalid)") has_rejected = std::stoi(kv.value) >= 1;
-    if (kv.key == "observations stamped in the future (dropped)") has_future = kv.value == "1";
-  }
+  // A status taken after the bad input was processed (however slow the machine), not one from before.
+  waitFor([&] {
+    has_rejected = has_future = false;
+    for (const auto& kv : statuses.back().values) {
+      if (kv.key == "rejected (invalid)") has_rejected = std::stoi(kv.value) >= 1;
+      if (kv.key == "observations stamped in the future (dropped)") has_future = kv.value == "1";
+    }
+    return has_rejected && has_future;
+  });
   EXPECT_TRUE(has_rejected);
   EXPECT_TRUE(has_future);
 
@@ -276,7 +282,7 @@ TEST_F(TrackerTest, PickersAddedAndRemovedAtRunTime) {
   std::vector<picker_localisation::PickerList> lists;
   ros::Subscriber registry = nh_.subscribe<picker_localisation::PickerList>(
       "/pickers/registry", 10, [&](const picker_localisation::PickerList::ConstPtr& m) { lists.push_back(*m); });
-  ASSERT_TRUE(waitFor([&] { return !lists.empty(); }, 5.0)) << "/pickers/registry is not latched";
+  ASSERT_TRUE(waitFor([&] { return !lists.empty(); })) << "/pickers/registry is not latched";
   EXPECT_EQ(lists.back().pickers.size(), 3u);
 
   // Bad requests: a clear message, nothing changes.
@@ -315,13 +321,13 @@ TEST_F(TrackerTest, PickersAddedAndRemovedAtRunTime) {
   ASSERT_TRUE(ros::service::call("/tpf_tracker/add_picker", add));
   ASSERT_TRUE(add.response.success) << add.response.message;
   EXPECT_EQ(listedIds(nh_), (std::vector<std::string>{"picker_1", "picker_2", "picker_3", "picker_4"}));
-  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 4u; }, 5.0));
+  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 4u; }));
   EXPECT_EQ(lists.back().pickers.back().gnss_topic, "/pickers/picker_4/fix");
-  ASSERT_TRUE(ros::service::waitForService("/pickers/picker_4/what_if", ros::Duration(5.0)));
+  ASSERT_TRUE(ros::service::waitForService("/pickers/picker_4/what_if", ros::Duration(60.0)));
   std::vector<PickerBelief> beliefs4;
   ros::Subscriber sub4 = nh_.subscribe<PickerBelief>(
       "/pickers/picker_4/belief", 20, [&](const PickerBelief::ConstPtr& m) { beliefs4.push_back(*m); });
-  ASSERT_TRUE(waitFor([&] { return sub4.getNumPublishers() > 0; }, 5.0));
+  ASSERT_TRUE(waitFor([&] { return sub4.getNumPublishers() > 0; }));
   spinFor(0.3);
   const std::string node_b = farNodes(*map_).second;
   const std::uint32_t p1 = topics_["picker_1"].beliefs.empty() ? 0 : topics_["picker_1"].beliefs.back().observations;
@@ -353,7 +359,7 @@ TEST_F(TrackerTest, PickersAddedAndRemovedAtRunTime) {
   ASSERT_TRUE(ros::service::call("/tpf_tracker/remove_picker", remove));
   EXPECT_TRUE(remove.response.success) << remove.response.message;
   EXPECT_EQ(listedIds(nh_), initial);
-  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 3u; }, 5.0));
+  ASSERT_TRUE(waitFor([&] { return lists.back().pickers.size() == 3u; }));
   EXPECT_FALSE(ros::service::exists("/pickers/picker_4/what_if", false));
   EXPECT_TRUE(ros::service::exists("/pickers/picker_1/what_if", false));
   // Added again, it starts afresh.

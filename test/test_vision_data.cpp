@@ -1,9 +1,11 @@
 // sensors_vision on real data (no roscore):
 // - the committed leg classifier (config/leg_classifier.yml) on the HELD-OUT labelled scans of
-//   ../shared/data/leg_tracker (positive_4_extracted.bag; a detection within 0.15 m of a labelled leg is a
-//   hit, one-to-one) and on the held-out last third of negative_2.bag (no people: every leg is false);
+//   leg_tracker's recordings in test/data (positive_4_extracted.bag; a detection within 0.15 m of a labelled
+//   leg is a hit, one-to-one) and on the held-out last third of negative_2.bag (no people: every leg is
+//   false);
 // - the HOG people detector on four frames of Debian opencv-doc's vtest.avi with boxes labelled by hand.
-// Bounds are set with a margin below/above the figures measured at commit time (docs/readme/sensors_vision.md).
+// Bounds are set with a margin below/above the figures measured at commit time
+// (docs/readme/sensors_vision.md).
 #include <gtest/gtest.h>
 
 #include <opencv2/videoio.hpp>
@@ -20,7 +22,7 @@ using namespace picker_localisation::vision;
 
 namespace {
 
-const std::string kLegData = std::string(PL_SHARED_DATA) + "/leg_tracker/rosbags/training_scans_res=0.33";
+const std::string kLegData = std::string(PL_TEST_DATA) + "/leg_tracker";
 const std::string kModel = std::string(PL_PACKAGE_DIR) + "/config/leg_classifier.yml";
 const std::string kVideo = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";
 

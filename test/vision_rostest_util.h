@@ -7,8 +7,12 @@
 
 namespace vision_test {
 
+// Wall s a wait for something that must happen allows by default: generous, for a loaded machine (the wait
+// ends as soon as its condition holds).
+constexpr double kDeadline = 60.0;
+
 // Spins until done() holds or `seconds` of wall time have passed; returns done().
-inline bool waitFor(const std::function<bool()>& done, double seconds) {
+inline bool waitFor(const std::function<bool()>& done, double seconds = kDeadline) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < end) {
     ros::spinOnce();

@@ -1,5 +1,5 @@
-// ROS message / bag adapters of the sensors_vision area: LaserScan -> core::LaserScan, and the labelled leg bags
-// of ../shared/data/leg_tracker (rosbag C++ API, no master needed).
+// ROS message / bag adapters of the sensors_vision area: LaserScan -> core::LaserScan, and the labelled leg
+// bags of leg_tracker's recordings (test/data/leg_tracker) (rosbag C++ API, no master needed).
 #pragma once
 
 #include <sensor_msgs/LaserScan.h>
