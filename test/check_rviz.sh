@@ -11,19 +11,31 @@ export PATH=/usr/bin:$PATH
 port=$((20000 + RANDOM % 20000))
 export ROS_MASTER_URI="http://localhost:$port" ROS_HOSTNAME=localhost
 log="$(mktemp)"; alive="$(mktemp)"
-xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
-  roslaunch -p $port '$launch' > '$log' 2>&1 &
-  sleep $settle
-  for _ in \$(seq $tries); do
-    import -window root '$out'
-    std=\$(convert '$out' -colorspace Gray -format '%[fx:standard_deviation]' info: 2>/dev/null)
-    colours=\$(convert '$out' -format '%k' info: 2>/dev/null)
-    awk -v s=\"\$std\" -v c=\"\$colours\" 'BEGIN{exit !(s > 0.05 && c > 50)}' && break
-    sleep 2
-  done
-  pgrep -f 'rviz -d' >/dev/null && echo RVIZ_ALIVE > '$alive'
-  rosnode kill -a >/dev/null 2>&1; sleep 1; kill %1 2>/dev/null; wait
-" >/dev/null 2>&1
+attempt() {
+  : > "$alive"
+  xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+    roslaunch -p $port '$launch' > '$log' 2>&1 &
+    sleep $settle
+    for _ in \$(seq $tries); do
+      import -window root '$out'
+      std=\$(convert '$out' -colorspace Gray -format '%[fx:standard_deviation]' info: 2>/dev/null)
+      colours=\$(convert '$out' -format '%k' info: 2>/dev/null)
+      awk -v s=\"\$std\" -v c=\"\$colours\" 'BEGIN{exit !(s > 0.05 && c > 50)}' && break
+      sleep 2
+    done
+    # [r]viz: the pattern must not match this script's own command line
+    pgrep -f '[r]viz/rviz -d' >/dev/null && echo RVIZ_ALIVE > '$alive'
+    rosnode kill -a >/dev/null 2>&1; sleep 1; kill %1 2>/dev/null; wait
+  " >/dev/null 2>&1
+}
+attempt
+# Debian's rviz under Xvfb once aborted at start-up inside its own code ("malloc(): unaligned tcache chunk
+# detected", exit code -6) while both cores were busy, and ran fine on the next start: a crash by a signal gets
+# one more start, said here; a second crash, or any other failure, fails the test.
+if grep -q "\[rviz-[0-9]*\] process has died .*exit code -" "$log"; then
+  echo "rviz crashed at start-up (killed by a signal): $(grep -m1 -E 'malloc|Segmentation|Aborted' "$log"); one more start"
+  attempt
+fi
 fail=0
 grep -q RVIZ_ALIVE "$alive" || { echo "FAIL: rviz is not running (once rendered, or after ${deadline} s)"; fail=1; }
 if grep -E "PluginlibFactory: The plugin for class|Failed to load|ERROR" "$log" | grep -v -E "media_export|XDG_RUNTIME_DIR"; then

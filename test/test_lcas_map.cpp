@@ -2,14 +2,19 @@
 // JSON on /topological_map_2, with meta.datum_latitude / datum_longitude and a transformation that rotates
 // the node poses by 90 degrees and shifts them by (40, -25) m. gnss_ingest has no datum file, so only the
 // map's datum can turn a picker's fix into map coordinates; the tracker must name the node where the fix puts
-// the picker on /picker_1/current_node.
+// the picker on /picker_1/current_node. Before it, a truncated map message: refused with one error and a
+// diagnostics ERROR by every node, which stay up and take the valid map that follows.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <ros/master.h>
 #include <ros/ros.h>
 #include <sensor_msgs/NavSatFix.h>
 #include <std_msgs/String.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -93,7 +98,42 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   EXPECT_NEAR(p_map.y(), -25.0 + p_file.x(), 1e-6);
   EXPECT_GT((p_map - p_file).norm(), 20.0);  // the test cannot pass with the transformation ignored
 
+  // First a truncated map message (a map manager cut off mid-send): every node reading the topic refuses it with
+  // one ERROR and a diagnostics ERROR, stays up and waits; the valid map that follows is taken.
+  std::mutex diag_mutex;
+  std::map<std::string, diagnostic_msgs::DiagnosticStatus> map_errors;  // by node
+  ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+        std::lock_guard<std::mutex> lock(diag_mutex);
+        for (const auto& st : a->status)
+          if (st.level == diagnostic_msgs::DiagnosticStatus::ERROR && st.name.find(": map") != std::string::npos)
+            map_errors[st.name.substr(0, st.name.find(": map"))] = st;
+      });
   ros::Publisher map_pub = nh.advertise<std_msgs::String>("/topological_map_2", 1, /*latch=*/true);
+  std_msgs::String truncated;
+  truncated.data = text.data.substr(0, text.data.size() / 3);
+  map_pub.publish(truncated);
+  const ros::WallTime refused_by = ros::WallTime::now() + ros::WallDuration(60.0);
+  while (ros::ok() && ros::WallTime::now() < refused_by) {
+    {
+      std::lock_guard<std::mutex> lock(diag_mutex);
+      if (map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker")) break;
+    }
+    ros::WallDuration(0.1).sleep();
+  }
+  {
+    std::lock_guard<std::mutex> lock(diag_mutex);
+    ASSERT_TRUE(map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker"))
+        << "no diagnostics ERROR for the truncated map from gnss_ingest and tpf_tracker";
+    for (const auto& kv : map_errors) {
+      EXPECT_NE(kv.second.message.find("/topological_map_2"), std::string::npos) << kv.second.message;
+      EXPECT_NE(kv.second.message.find("YAML syntax error"), std::string::npos) << kv.second.message;
+    }
+  }
+  std::vector<std::string> nodes;
+  ASSERT_TRUE(ros::master::getNodes(nodes));
+  for (const char* node : {"/gnss_ingest", "/tpf_tracker"})
+    EXPECT_NE(std::find(nodes.begin(), nodes.end(), node), nodes.end()) << node << " died on the bad map";
   map_pub.publish(text);
   std::mutex m;
   std::string current;

@@ -1,9 +1,11 @@
 #include "picker_localisation/ros/map_source.h"
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/master.h>
 #include <ros/topic.h>
 #include <std_msgs/String.h>
 
+#include <cstdint>
 #include <stdexcept>
 
 #include "picker_localisation/ros/map_conversions.h"
@@ -37,6 +39,66 @@ std::string topicType(const std::string& topic) {
   return "";
 }
 
+// A map message that cannot be read is bad input, not a reason to stop: one ERROR line and a diagnostics ERROR
+// ("<node>: map"), then the node waits for the next message. The node's own diagnostics updater does not exist
+// yet (it needs the map), so the status goes out here.
+class MapRefusals {
+ public:
+  MapRefusals(ros::NodeHandle& nh, std::string node, std::string topic)
+      : nh_(nh), node_(std::move(node)), topic_(std::move(topic)) {}
+
+  // True when `fingerprint` is the message refused last (a latched topic delivers it again until replaced).
+  bool alreadyRefused(const std::string& fingerprint) const { return refused_ && fingerprint == fingerprint_; }
+
+  void refuse(const std::string& fingerprint, const std::string& why) {
+    refused_ = true;
+    fingerprint_ = fingerprint;
+    last_error_ = why;
+    ROS_ERROR("%s: map message on %s refused, waiting for a valid one: %s", node_.c_str(), topic_.c_str(),
+              why.c_str());
+    report(diagnostic_msgs::DiagnosticStatus::ERROR, "map message on " + topic_ + " refused: " + why);
+  }
+
+  // After a refusal, the valid map taken clears the ERROR (OK, same status name).
+  void taken(const topology::TopologicalMap& map) {
+    if (!refused_) return;
+    ROS_INFO("%s: valid map '%s' on %s taken after the refused one", node_.c_str(), map.name().c_str(),
+             topic_.c_str());
+    report(diagnostic_msgs::DiagnosticStatus::OK, "map '" + map.name() + "' taken from " + topic_);
+  }
+
+  const std::string& lastError() const { return last_error_; }
+
+ private:
+  void report(std::uint8_t level, const std::string& message) {
+    // Kept for the process's life (never destroyed: a publisher must not outlive roscpp's shutdown), so the last
+    // status (latched) still reaches late subscribers after the map is taken and this object is gone.
+    static ros::Publisher* const diag_pub =
+        new ros::Publisher(nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1, true));
+    diagnostic_msgs::DiagnosticArray array;
+    array.header.stamp = ros::Time::now();
+    diagnostic_msgs::DiagnosticStatus status;
+    status.level = level;
+    status.name = (node_.rfind('/', 0) == 0 ? node_.substr(1) : node_) + ": map";
+    status.hardware_id = "none";
+    status.message = message;
+    array.status.push_back(status);
+    diag_pub->publish(array);
+  }
+
+  ros::NodeHandle& nh_;
+  std::string node_, topic_;
+  bool refused_ = false;
+  std::string fingerprint_, last_error_;
+};
+
+// What tells two map messages apart cheaply enough (the text itself; the header and size of a map message).
+std::string fingerprintOf(const std_msgs::String& m) { return m.data; }
+std::string fingerprintOf(const picker_localisation::TopologicalMap& m) {
+  return std::to_string(m.header.seq) + "/" + std::to_string(m.header.stamp.toNSec()) + "/" +
+         std::to_string(m.nodes.size());
+}
+
 }  // namespace
 
 std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, ros::NodeHandle& pnh,
@@ -48,20 +110,38 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
     if (!map_file.empty()) return std::make_shared<topology::TopologicalMap>(topology::loadMap(map_file));
     const std::string topic = mapTopic(nh, pnh);
     ROS_INFO("%s: waiting for the topological map on %s", name.c_str(), topic.c_str());
+    MapRefusals refusals(nh, name, topic);
     ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout > 0 ? timeout : 1e9);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       const std::string type = topicType(topic);
       if (type == "picker_localisation/TopologicalMap") {
         auto msg =
             ros::topic::waitForMessage<picker_localisation::TopologicalMap>(topic, nh, ros::Duration(1.0));
-        if (msg) return std::make_shared<topology::TopologicalMap>(fromMsg(*msg));
+        if (msg && refusals.alreadyRefused(fingerprintOf(*msg))) {
+          ros::WallDuration(0.2).sleep();
+        } else if (msg) {
+          try {
+            auto map = std::make_shared<topology::TopologicalMap>(fromMsg(*msg));
+            refusals.taken(*map);
+            return map;
+          } catch (const topology::MapError& e) {
+            refusals.refuse(fingerprintOf(*msg), e.what());
+          }
+        }
       } else if (type == "std_msgs/String") {
         auto msg = ros::topic::waitForMessage<std_msgs::String>(topic, nh, ros::Duration(1.0));
-        if (msg) {
-          auto map = std::make_shared<topology::TopologicalMap>(topology::parseMap(msg->data, topic));
-          ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(),
-                   map->name().c_str(), topic.c_str(), map->numNodes(), map->numLanes());
-          return map;
+        if (msg && refusals.alreadyRefused(fingerprintOf(*msg))) {
+          ros::WallDuration(0.2).sleep();
+        } else if (msg) {
+          try {
+            auto map = std::make_shared<topology::TopologicalMap>(topology::parseMap(msg->data, topic));
+            ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(),
+                     map->name().c_str(), topic.c_str(), map->numNodes(), map->numLanes());
+            refusals.taken(*map);
+            return map;
+          } catch (const topology::MapError& e) {
+            refusals.refuse(fingerprintOf(*msg), e.what());
+          }
         }
       } else if (!type.empty()) {
         ROS_FATAL(
@@ -74,8 +154,12 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
         ros::WallDuration(0.2).sleep();
       }
     }
-    ROS_FATAL("%s: no topological map on %s within %.0f s and no ~map_file parameter", name.c_str(),
-              topic.c_str(), timeout);
+    if (refusals.lastError().empty())
+      ROS_FATAL("%s: no topological map on %s within %.0f s and no ~map_file parameter", name.c_str(),
+                topic.c_str(), timeout);
+    else
+      ROS_FATAL("%s: no valid topological map on %s within %.0f s (the last one was refused: %s)", name.c_str(),
+                topic.c_str(), timeout, refusals.lastError().c_str());
   } catch (const topology::MapError& e) {
     ROS_FATAL("%s: %s", name.c_str(), e.what());
   }
