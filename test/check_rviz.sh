@@ -28,14 +28,15 @@ attempt() {
     rosnode kill -a >/dev/null 2>&1; sleep 1; kill %1 2>/dev/null; wait
   " >/dev/null 2>&1
 }
-attempt
-# Debian's rviz under Xvfb once aborted at start-up inside its own code ("malloc(): unaligned tcache chunk
-# detected", exit code -6) while both cores were busy, and ran fine on the next start: a crash by a signal gets
-# one more start, said here; a second crash, or any other failure, fails the test.
-if grep -q "\[rviz-[0-9]*\] process has died .*exit code -" "$log"; then
-  echo "rviz crashed at start-up (killed by a signal): $(grep -m1 -E 'malloc|Segmentation|Aborted' "$log"); one more start"
+# Debian's rviz under Xvfb aborted at start-up inside its own heap twice in five runs of the suite while a build
+# loaded both cores ("malloc(): unaligned tcache chunk detected", "free(): invalid next size", exit code -6), and
+# ran fine when started again; not reproduced with the same load in 14 starts alone. A crash by a signal gets up to
+# two more starts, each said here; a third crash, or any other failure, fails the test.
+for start in 1 2 3; do
   attempt
-fi
+  grep -q "\[rviz-[0-9]*\] process has died .*exit code -" "$log" || break
+  echo "start $start: rviz was killed by a signal: $(grep -m1 -E 'malloc|free\(\)|corrupt|Segmentation' "$log")"
+done
 fail=0
 grep -q RVIZ_ALIVE "$alive" || { echo "FAIL: rviz is not running (once rendered, or after ${deadline} s)"; fail=1; }
 if grep -E "PluginlibFactory: The plugin for class|Failed to load|ERROR" "$log" | grep -v -E "media_export|XDG_RUNTIME_DIR"; then
