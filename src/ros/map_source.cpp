@@ -6,6 +6,7 @@
 #include <std_msgs/String.h>
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 
 #include "picker_localisation/ros/map_conversions.h"
@@ -39,19 +40,20 @@ std::string topicType(const std::string& topic) {
   return "";
 }
 
-// A map message that cannot be read is bad input, not a reason to stop: one ERROR line and a diagnostics ERROR
-// ("<node>: map"), then the node waits for the next message. The node's own diagnostics updater does not exist
-// yet (it needs the map), so the status goes out here.
+// A map message that cannot be read is bad input, not a reason to stop: one ERROR line and a diagnostics
+// ERROR ("<node>: map"), then the node waits for the next message. The node's own diagnostics updater does
+// not exist yet (it needs the map), so the status goes out here.
 class MapRefusals {
  public:
   MapRefusals(ros::NodeHandle& nh, std::string node, std::string topic)
       : nh_(nh), node_(std::move(node)), topic_(std::move(topic)) {}
 
   // True when `fingerprint` is the message refused last (a latched topic delivers it again until replaced).
-  bool alreadyRefused(const std::string& fingerprint) const { return refused_ && fingerprint == fingerprint_; }
+  bool alreadyRefused(const std::string& fingerprint) const {
+    return fingerprint_ && fingerprint == *fingerprint_;
+  }
 
   void refuse(const std::string& fingerprint, const std::string& why) {
-    refused_ = true;
     fingerprint_ = fingerprint;
     last_error_ = why;
     ROS_ERROR("%s: map message on %s refused, waiting for a valid one: %s", node_.c_str(), topic_.c_str(),
@@ -61,7 +63,7 @@ class MapRefusals {
 
   // After a refusal, the valid map taken clears the ERROR (OK, same status name).
   void taken(const topology::TopologicalMap& map) {
-    if (!refused_) return;
+    if (!fingerprint_) return;
     ROS_INFO("%s: valid map '%s' on %s taken after the refused one", node_.c_str(), map.name().c_str(),
              topic_.c_str());
     report(diagnostic_msgs::DiagnosticStatus::OK, "map '" + map.name() + "' taken from " + topic_);
@@ -71,8 +73,8 @@ class MapRefusals {
 
  private:
   void report(std::uint8_t level, const std::string& message) {
-    // Kept for the process's life (never destroyed: a publisher must not outlive roscpp's shutdown), so the last
-    // status (latched) still reaches late subscribers after the map is taken and this object is gone.
+    // Kept for the process's life (never destroyed: a publisher must not outlive roscpp's shutdown), so the
+    // last status (latched) still reaches late subscribers after the map is taken and this object is gone.
     static ros::Publisher* const diag_pub =
         new ros::Publisher(nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1, true));
     diagnostic_msgs::DiagnosticArray array;
@@ -88,15 +90,39 @@ class MapRefusals {
 
   ros::NodeHandle& nh_;
   std::string node_, topic_;
-  bool refused_ = false;
-  std::string fingerprint_, last_error_;
+  std::optional<std::string> fingerprint_;  // of the message refused last; none before any refusal
+  std::string last_error_;
 };
 
 // What tells two map messages apart cheaply enough (the text itself; the header and size of a map message).
-std::string fingerprintOf(const std_msgs::String& m) { return m.data; }
+std::string fingerprintOf(const std_msgs::String& m) {
+  return m.data;
+}
 std::string fingerprintOf(const picker_localisation::TopologicalMap& m) {
   return std::to_string(m.header.seq) + "/" + std::to_string(m.header.stamp.toNSec()) + "/" +
          std::to_string(m.nodes.size());
+}
+
+// One message of type M from `topic`, turned into a map by `convert`; nullptr when none came within a second,
+// when it is the message refused last, or when it is refused now.
+template <typename M, typename Convert>
+std::shared_ptr<const topology::TopologicalMap> takeMap(const std::string& topic, ros::NodeHandle& nh,
+                                                        MapRefusals& refusals, Convert convert) {
+  const auto msg = ros::topic::waitForMessage<M>(topic, nh, ros::Duration(1.0));
+  if (!msg) return nullptr;
+  const std::string fingerprint = fingerprintOf(*msg);
+  if (refusals.alreadyRefused(fingerprint)) {
+    ros::WallDuration(0.2).sleep();
+    return nullptr;
+  }
+  try {
+    std::shared_ptr<const topology::TopologicalMap> map = convert(*msg);
+    refusals.taken(*map);
+    return map;
+  } catch (const topology::MapError& e) {
+    refusals.refuse(fingerprint, e.what());
+    return nullptr;
+  }
 }
 
 }  // namespace
@@ -114,35 +140,18 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
     ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout > 0 ? timeout : 1e9);
     while (ros::ok() && ros::WallTime::now() < deadline) {
       const std::string type = topicType(topic);
+      std::shared_ptr<const topology::TopologicalMap> map;
       if (type == "picker_localisation/TopologicalMap") {
-        auto msg =
-            ros::topic::waitForMessage<picker_localisation::TopologicalMap>(topic, nh, ros::Duration(1.0));
-        if (msg && refusals.alreadyRefused(fingerprintOf(*msg))) {
-          ros::WallDuration(0.2).sleep();
-        } else if (msg) {
-          try {
-            auto map = std::make_shared<topology::TopologicalMap>(fromMsg(*msg));
-            refusals.taken(*map);
-            return map;
-          } catch (const topology::MapError& e) {
-            refusals.refuse(fingerprintOf(*msg), e.what());
-          }
-        }
+        map = takeMap<picker_localisation::TopologicalMap>(topic, nh, refusals, [](const auto& m) {
+          return std::make_shared<topology::TopologicalMap>(fromMsg(m));
+        });
       } else if (type == "std_msgs/String") {
-        auto msg = ros::topic::waitForMessage<std_msgs::String>(topic, nh, ros::Duration(1.0));
-        if (msg && refusals.alreadyRefused(fingerprintOf(*msg))) {
-          ros::WallDuration(0.2).sleep();
-        } else if (msg) {
-          try {
-            auto map = std::make_shared<topology::TopologicalMap>(topology::parseMap(msg->data, topic));
-            ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(),
-                     map->name().c_str(), topic.c_str(), map->numNodes(), map->numLanes());
-            refusals.taken(*map);
-            return map;
-          } catch (const topology::MapError& e) {
-            refusals.refuse(fingerprintOf(*msg), e.what());
-          }
-        }
+        map = takeMap<std_msgs::String>(topic, nh, refusals, [&](const std_msgs::String& m) {
+          auto parsed = std::make_shared<topology::TopologicalMap>(topology::parseMap(m.data, topic));
+          ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(),
+                   parsed->name().c_str(), topic.c_str(), parsed->numNodes(), parsed->numLanes());
+          return parsed;
+        });
       } else if (!type.empty()) {
         ROS_FATAL(
             "%s: %s is a %s; a map topic must be picker_localisation/TopologicalMap (topological_map_server) "
@@ -153,13 +162,14 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
       } else {
         ros::WallDuration(0.2).sleep();
       }
+      if (map) return map;
     }
     if (refusals.lastError().empty())
       ROS_FATAL("%s: no topological map on %s within %.0f s and no ~map_file parameter", name.c_str(),
                 topic.c_str(), timeout);
     else
-      ROS_FATAL("%s: no valid topological map on %s within %.0f s (the last one was refused: %s)", name.c_str(),
-                topic.c_str(), timeout, refusals.lastError().c_str());
+      ROS_FATAL("%s: no valid topological map on %s within %.0f s (the last one was refused: %s)",
+                name.c_str(), topic.c_str(), timeout, refusals.lastError().c_str());
   } catch (const topology::MapError& e) {
     ROS_FATAL("%s: %s", name.c_str(), e.what());
   }
