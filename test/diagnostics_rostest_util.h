@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "wait_deadline.h"
+
 namespace diagnostics_test {
 
-// Wall s a collection waits at most by default: generous, for a loaded machine (it returns as soon as every
-// expected node reported).
-constexpr double kDeadline = 60.0;
+using test_wait::kDeadline;  // a collection returns as soon as every expected node reported
 
 // The statuses of each node (by its graph name, with the leading slash) seen within `wall_timeout` s; returns
 // early once every node in `expected` has reported.

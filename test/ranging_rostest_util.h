@@ -14,8 +14,9 @@
 #include <string>
 #include <vector>
 
-#include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/core/geodetic_datum.h"
+#include "picker_localisation/ros/ranging_nodes.h"
+#include "wait_deadline.h"
 
 namespace ranging_test {
 
@@ -37,9 +38,7 @@ struct Collector {
   }
 };
 
-// Wall s a wait for something that must happen allows by default: generous, for a loaded machine (the wait
-// ends as soon as its condition holds).
-constexpr double kDeadline = 60.0;
+using test_wait::kDeadline;
 
 // Spins until pred() or `seconds` (wall) have passed; returns pred().
 inline bool waitFor(const std::function<bool()>& pred, double seconds = kDeadline) {

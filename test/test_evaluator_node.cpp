@@ -52,7 +52,7 @@ struct Fixture {
   // Waits until an error message satisfying `pred` arrives (clearing older ones first); the default deadline
   // is generous, for a loaded machine.
   template <typename Pred>
-  bool waitFor(Pred pred, double seconds = 60.0) {
+  bool waitFor(Pred pred, double seconds = test_wait::kDeadline) {
     errors.clear();
     const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
     while (ros::ok() && ros::WallTime::now() < end) {

@@ -57,7 +57,7 @@ struct Recorder {
 
 // Waits (wall time) until pred() or timeout (by default generous, for a loaded machine).
 template <class P>
-bool waitFor(P pred, double wall_timeout = 60.0) {
+bool waitFor(P pred, double wall_timeout = test_wait::kDeadline) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(wall_timeout);
   while (ros::WallTime::now() < end) {
     if (pred()) return true;

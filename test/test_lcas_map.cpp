@@ -14,14 +14,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <sstream>
 
 #include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/topology/map_io.h"
+#include "wait_deadline.h"
 
 using namespace picker_localisation;
 
@@ -98,22 +99,23 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   EXPECT_NEAR(p_map.y(), -25.0 + p_file.x(), 1e-6);
   EXPECT_GT((p_map - p_file).norm(), 20.0);  // the test cannot pass with the transformation ignored
 
-  // First a truncated map message (a map manager cut off mid-send): every node reading the topic refuses it with
-  // one ERROR and a diagnostics ERROR, stays up and waits; the valid map that follows is taken.
+  // First a truncated map message (a map manager cut off mid-send): every node reading the topic refuses it
+  // with one ERROR and a diagnostics ERROR, stays up and waits; the valid map that follows is taken.
   std::mutex diag_mutex;
   std::map<std::string, diagnostic_msgs::DiagnosticStatus> map_errors;  // by node
   ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
         std::lock_guard<std::mutex> lock(diag_mutex);
         for (const auto& st : a->status)
-          if (st.level == diagnostic_msgs::DiagnosticStatus::ERROR && st.name.find(": map") != std::string::npos)
+          if (st.level == diagnostic_msgs::DiagnosticStatus::ERROR &&
+              st.name.find(": map") != std::string::npos)
             map_errors[st.name.substr(0, st.name.find(": map"))] = st;
       });
   ros::Publisher map_pub = nh.advertise<std_msgs::String>("/topological_map_2", 1, /*latch=*/true);
   std_msgs::String truncated;
   truncated.data = text.data.substr(0, text.data.size() / 3);
   map_pub.publish(truncated);
-  const ros::WallTime refused_by = ros::WallTime::now() + ros::WallDuration(60.0);
+  const ros::WallTime refused_by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
   while (ros::ok() && ros::WallTime::now() < refused_by) {
     {
       std::lock_guard<std::mutex> lock(diag_mutex);
@@ -149,7 +151,7 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   c.longitude = kDatumLongitude;
   const core::GeodeticDatum datum(c);
   const std::string expected = lcas_map.node(target).name;
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(60.0);
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
   bool reached = false;
   while (ros::ok() && ros::WallTime::now() < end && !reached) {
     fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));

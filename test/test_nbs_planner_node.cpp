@@ -29,6 +29,7 @@
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
+#include "wait_deadline.h"
 
 using namespace picker_localisation;
 using topology::NodeIndex;
@@ -99,7 +100,7 @@ void markerCallback(const visualization_msgs::MarkerArray::ConstPtr& m) {
 }
 
 // Waits until done() or `seconds` of wall time (by default generous, for a loaded machine).
-bool waitFor(const std::function<bool()>& done, double seconds = 60.0) {
+bool waitFor(const std::function<bool()>& done, double seconds = test_wait::kDeadline) {
   const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
   while (ros::ok() && ros::WallTime::now() < end) {
     if (done()) return true;
@@ -119,7 +120,7 @@ std::string diagnosticValue(const std::string& robot, const std::string& key) {
 }
 
 // True when `robot` publishes a goal stamped after now within `seconds` (its planner is still planning).
-bool plansAgain(const std::string& robot, double seconds = 60.0) {
+bool plansAgain(const std::string& robot, double seconds = test_wait::kDeadline) {
   const ros::Time now = ros::Time::now();
   return waitFor(
       [&] {

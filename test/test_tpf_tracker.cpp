@@ -24,6 +24,7 @@
 
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/topology/map_io.h"
+#include "wait_deadline.h"
 
 using namespace picker_localisation;
 
@@ -78,7 +79,7 @@ class TrackerTest : public ::testing::Test {
   }
   // Default deadline: generous, for a loaded machine (the wait ends as soon as pred() holds).
   template <typename Pred>
-  bool waitFor(Pred pred, double seconds = 60.0) {
+  bool waitFor(Pred pred, double seconds = test_wait::kDeadline) {
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(seconds);
     while (ros::WallTime::now() < until) {
       ros::spinOnce();

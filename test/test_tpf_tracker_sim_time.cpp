@@ -12,6 +12,7 @@
 
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/topology/map_io.h"
+#include "wait_deadline.h"
 
 using namespace picker_localisation;
 
@@ -37,7 +38,7 @@ TEST(TrackerSimTime, PeriodicPredictionFollowsTheSimulatedClock) {
   };
   // Spins until done() or 60 s of wall time (generous, for a loaded machine); returns done().
   auto waitWall = [&](auto done) {
-    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60.0);
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
     while (!done() && ros::WallTime::now() < until) {
       ros::spinOnce();
       ros::WallDuration(0.01).sleep();
@@ -46,7 +47,7 @@ TEST(TrackerSimTime, PeriodicPredictionFollowsTheSimulatedClock) {
   };
   setClock(100.0);
   ASSERT_TRUE(ros::service::waitForService("/pickers/picker_sim/what_if", ros::Duration(30.0)));
-  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60.0);
+  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
   while (obs_pub.getNumSubscribers() == 0 && ros::WallTime::now() < until) ros::WallDuration(0.05).sleep();
   ASSERT_GT(obs_pub.getNumSubscribers(), 0u);
 

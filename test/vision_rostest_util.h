@@ -5,11 +5,11 @@
 
 #include <functional>
 
+#include "wait_deadline.h"
+
 namespace vision_test {
 
-// Wall s a wait for something that must happen allows by default: generous, for a loaded machine (the wait
-// ends as soon as its condition holds).
-constexpr double kDeadline = 60.0;
+using test_wait::kDeadline;
 
 // Spins until done() holds or `seconds` of wall time have passed; returns done().
 inline bool waitFor(const std::function<bool()>& done, double seconds = kDeadline) {
