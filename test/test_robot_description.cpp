@@ -1,4 +1,4 @@
-// The shipped URDF: sensor mounts read with urdfdom match seed 004 Table 1 and the documented layout.
+// The shipped URDF: sensor mounts read with urdfdom match Sarmento et al. 2024, Table 1 and the documented layout.
 #include <gtest/gtest.h>
 
 #include <cmath>

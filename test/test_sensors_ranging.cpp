@@ -1,5 +1,6 @@
 // sensors_ranging core classes against hand-computed values: datum, GNSS ingest, RFID model, Range Histogram
-// Filter (seed 004 Eqs. 2-7), UWB ranging and the two-antenna PDoA relative position (seed 002). No roscore.
+// Filter (Sarmento et al. 2024, Eqs. 2-7), UWB ranging and the two-antenna PDoA relative position (Periotto and
+// Sartori). No roscore.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -599,7 +600,7 @@ TEST(RangeHistogramFilter, BadInputLeavesTheFilterUnchanged) {
 }
 
 // ---------------------------------------------------------------------------------------------------------
-// Seed 002 PDoA and UwbRanging
+// Periotto and Sartori PDoA and UwbRanging
 
 TEST(Pdoa, RelativePositionFromRangeAndPathDifference) {
   // Tag at (3, 4), antennas at (0, 0) and (1, 0): r = 5, r2 = sqrt(20), p = 5 - sqrt(20).
@@ -611,7 +612,7 @@ TEST(Pdoa, RelativePositionFromRangeAndPathDifference) {
   EXPECT_NEAR(relativePositionFromPathDifference(r, r - r2, 1.0, false)->y(), -4.0, 1e-12);
   EXPECT_FALSE(relativePositionFromPathDifference(r, 1.5, 1.0).has_value());  // |p| > d
   EXPECT_FALSE(relativePositionFromPathDifference(kNaN, 0.1, 1.0).has_value());
-  // Seed 002: d = lambda / 2 at 6.5 GHz (~0.023 m); a phase difference of pi is a path difference of d.
+  // Periotto and Sartori: d = lambda / 2 at 6.5 GHz (~0.023 m); a phase difference of pi is a path difference of d.
   const double lambda = 299792458.0 / 6.5e9;
   EXPECT_NEAR(pathDifferenceFromPhase(M_PI, lambda), lambda / 2.0, 1e-15);
   const Eigen::Vector2d q = relativePositionFromAngle(2.0, M_PI / 2.0);
@@ -776,10 +777,10 @@ TEST(UwbRanging, PdoaDirectAndAsBearing) {
   EXPECT_NEAR(out[0].position->y(), 5.0, 0.3);
 }
 
-// A person walking at 0.21 m/s (seed 004 Sec. 5) 3-6 m from a still robot, UWB ranges with 0.1 m Gaussian
+// A person walking at 0.21 m/s (Sarmento et al. 2024, Sec. 5) 3-6 m from a still robot, UWB ranges with 0.1 m Gaussian
 // noise from the three anchors at 10 Hz, for 60 s (seeded). Mean error with UWB only and with a camera
 // bearing (0.03 rad noise): the RHF must track, and the bearing must reduce the angular (tangential) error
-// (seed 004 reports a 66.67 % reduction of the angular error with its anchor layout and camera).
+// (Sarmento et al. 2024 reports a 66.67 % reduction of the angular error with its anchor layout and camera).
 TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
   double mean_err[2] = {0.0, 0.0}, mean_tan[2] = {0.0, 0.0};
   for (int use_cam = 0; use_cam < 2; ++use_cam) {

@@ -1,7 +1,7 @@
 // rostest: uwb_ranging through ROS. Unknown tag, NaN and negative ranges, a stamp going backwards and missing
 // tf (an anchor frame nobody publishes, a robot whose base_link is unknown) publish nothing and do not stop the
 // node; good ranges from three anchors before and after become identifying Observations at the picker's
-// position in the map (RHF, seed 004); a camera bearing is accepted; diagnostics count the drops.
+// position in the map (RHF, Sarmento et al. 2024); a camera bearing is accepted; diagnostics count the drops.
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <picker_localisation/BearingDetectionArray.h>

@@ -281,7 +281,7 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
   obs.identifying = true;
   core::GaussianLikelihoodOptions lo = options_.likelihoodOptions();
   if (bias_.usable(fix.stamp)) {
-    // Bias removed (seed 001 Sec. VI): the fix minus the estimate, with the estimate's own uncertainty in
+    // Bias removed (Khan et al. 2020, Sec. VI): the fix minus the estimate, with the estimate's own uncertainty in
     // place of the unit's reported one (which is mostly the bias itself).
     const double r2 = options_.bias.residual_std * options_.bias.residual_std;
     lo.min_sigma = options_.bias.min_sigma;

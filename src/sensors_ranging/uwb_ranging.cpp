@@ -48,7 +48,7 @@ const char* toString(UwbRejection r) {
   return "unknown";
 }
 
-// The RHF's keys in the node's files (seed 004 names), then the ranging keys, then the node's own keys.
+// The RHF's keys in the node's files (names of Sarmento et al. 2024), then the ranging keys, then the node's own keys.
 const std::vector<std::string>& UwbRangingOptions::yamlKeys() {
   static const std::vector<std::string> keys{
       "grid_size_x", "grid_size_y", "grid_resolution", "max_speed", "p_threshold", "p_min_uwb", "p_min_cam",
@@ -186,7 +186,7 @@ UwbRejection UwbRanging::addRange(const UwbRangeInput& in, const Eigen::Isometry
   const double variance = in.variance > 0.0 ? in.variance : options_.rhf.default_range_sigma * options_.rhf.default_range_sigma;
   const double anchor_yaw = std::atan2(in.anchor_in_robot.linear()(1, 0), in.anchor_in_robot.linear()(0, 0));
   if (in.pdoa_angle && options_.pdoa_mode == "direct") {
-    // Seed 002: range + angle -> relative position in the anchor frame -> map frame.
+    // Periotto and Sartori: range + angle -> relative position in the anchor frame -> map frame.
     const Eigen::Isometry2d anchor_in_map = robot_pose * in.anchor_in_robot;
     const Eigen::Vector2d p = anchor_in_map * relativePositionFromAngle(in.range, *in.pdoa_angle);
     const Eigen::Matrix2d c_anchor =

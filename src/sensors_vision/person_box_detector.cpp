@@ -227,7 +227,7 @@ double bearingFromBox(const cv::Rect& box, const CameraIntrinsics& k) {
 double bearingFromColumnFov(double u, double horizontal_fov, int width) {
   if (width <= 0 || !(horizontal_fov > 0.0)) throw std::invalid_argument("bearingFromColumnFov: bad fov/width");
   const double dx = 0.5 * width - u;  // positive left of the centre
-  return std::atan(2.0 * dx * std::tan(0.5 * horizontal_fov) / width);  // seed 004 Eq. 1
+  return std::atan(2.0 * dx * std::tan(0.5 * horizontal_fov) / width);  // Sarmento et al. 2024, Eq. 1
 }
 
 }  // namespace vision

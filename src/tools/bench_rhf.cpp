@@ -1,5 +1,6 @@
-// bench_rhf: one Range Histogram Filter update (seed 004 Eqs. 2-7) on a 20 m x 20 m grid with 5 cm cells
-// (400 x 400 cells). Target: <= 1 ms on one core (seed 004 reports 18.3 ms per cycle for its implementation).
+// bench_rhf: one Range Histogram Filter update (Sarmento et al. 2024, Eqs. 2-7) on a 20 m x 20 m grid with
+// 5 cm cells (400 x 400 cells). Target: <= 1 ms on one core (Sarmento et al. 2024 report 18.3 ms per cycle
+// for their implementation).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -11,8 +12,8 @@ namespace ps = picker_localisation::sensors;
 
 namespace {
 
-// Three anchors as in seed 004 Table 1 (front-left, front-right, rear), a person 4 m ahead walking sideways,
-// ranges at 10 Hz, the robot driving forward at 0.5 m/s.
+// Three anchors as in Sarmento et al. 2024, Table 1 (front-left, front-right, rear), a person 4 m ahead walking
+// sideways, ranges at 10 Hz, the robot driving forward at 0.5 m/s.
 void runUpdates(benchmark::State& state, bool with_camera, bool moving) {
   ps::RhfOptions o;  // 20 m x 20 m, 0.05 m
   ps::RangeHistogramFilter rhf(o);

@@ -1,5 +1,5 @@
 // ROS adapter of the monocular person detector (sensors_vision area): Image + CameraInfo -> person boxes (HOG by
-// default, optional ONNX via cv::dnn) -> bearing of each box (seed 004 Eq. 1) -> BearingDetectionArray on
+// default, optional ONNX via cv::dnn) -> bearing of each box (Sarmento et al. 2024, Eq. 1) -> BearingDetectionArray on
 // `detections` + annotated `debug_image`. Runs at most ~max_rate Hz; frames older than ~max_age are dropped.
 #pragma once
 

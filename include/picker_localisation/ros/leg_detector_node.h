@@ -1,6 +1,6 @@
 // ROS adapter of the leg detector (sensors_vision area): LaserScan topic(s) and optionally a PointCloud2 ->
 // people in the fixed (map) frame -> PersonDetectionArray on `people` + one non-identifying Observation per
-// person on /observations. Fusion with a camera when ~detections_topic is set (seed 003 Algorithm 4).
+// person on /observations. Fusion with a camera when ~detections_topic is set (Antonucci 2022 Algorithm 4).
 #pragma once
 
 #include "picker_localisation/ros/node_diagnostics.h"

@@ -1,4 +1,4 @@
-// Online estimate of one GNSS device's bias (Khan et al., seed 001 Sec. VI: "estimate the GNSS bias from the
+// Online estimate of one GNSS device's bias (Khan et al. 2020 Sec. VI: "estimate the GNSS bias from the
 // robot's own sensing"). ROS-free.
 //
 // Why a state and not a per-fix offset: a phone or IoT unit is wrong by an almost constant offset plus a slow

@@ -1,5 +1,5 @@
 // GNSS fixes of one picker -> identifying Observations over map nodes (Navigate-and-Seek Sec. IV/VI; outlier
-// gating after seed 002). ROS-free: the node converts sensor_msgs/NavSatFix into core::GnssFix, and the
+// gating after Periotto and Sartori). ROS-free: the node converts sensor_msgs/NavSatFix into core::GnssFix, and the
 // offline experiment runner feeds the simulator's core::GnssFix directly.
 #pragma once
 
@@ -75,7 +75,7 @@ struct GnssIngestOptions {
   double cutoff_sigmas = 3.0;       // nodes farther than this many sigmas are left out of the likelihood
   std::size_t max_nodes = 0;        // keep at most this many most likely nodes (0: no limit)
   std::size_t velocity_window = 10; // velocity from the last N accepted fixes (paper: 10); < 2 disables it
-  // Impossible-jump gate (Mahalanobis, after seed 002): with d the displacement from the last accepted fix,
+  // Impossible-jump gate (Mahalanobis, after Periotto and Sartori): with d the displacement from the last accepted fix,
   // dt its age and C = C_last + C_new + (max_speed * dt)^2 I, a fix is rejected when d^T C^-1 d > gate^2.
   // After `jump_reset_count` consecutive jump rejections the gate re-anchors on the newest fix (so one bad
   // reference cannot lock the picker out); the gate is also skipped after a blackout.

@@ -1,4 +1,4 @@
-// Identity for anonymous people detections (issue "Find the lane", seed 001 Sec. VI). ROS-free.
+// Identity for anonymous people detections (issue "Find the lane", Khan et al. 2020, Sec. VI). ROS-free.
 //
 // A confirmed person from the LiDAR (or camera-fused legs) names nobody. Each picker predicts where it is from
 // two sources:

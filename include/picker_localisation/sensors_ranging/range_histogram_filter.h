@@ -1,4 +1,4 @@
-// Range Histogram Filter (seed 004 Sec. 4.3, Eqs. 2-7): a robot-centred 2D grid fusing UWB ranges from
+// Range Histogram Filter (Sarmento et al. 2024, Sec. 4.3, Eqs. 2-7): a robot-centred 2D grid fusing UWB ranges from
 // anchors on the robot (annuli) with camera bearings (wedges), innovation by dilation with a maximum speed,
 // and the P_min floors. ROS-free; one filter per tracked tag.
 //
@@ -55,7 +55,7 @@ struct RhfOptions {
   // Camera association gate: a bearing is used only when its wedge reaches UWB cells of normalised value
   // >= camera_gate (max over the wedge of M^uwb * wedge); 0 uses every bearing. Cameras see every person and
   // may miss the target (occlusion, field of view): without the gate a bystander's wedge would pull the
-  // estimate along the UWB arc. Not in seed 004 (which follows one person).
+  // estimate along the UWB arc. Not in Sarmento et al. 2024 (which follows one person).
   double camera_gate = 0.1;
 };
 

@@ -1,7 +1,7 @@
-// UWB ranges from anchors on a robot to the picker's tags -> per tag a Range Histogram Filter (seed 004) ->
-// identifying Observation; or, as an alternative input, the two-antenna range + phase-difference relative
-// position (seed 002). ROS-free: the uwb_ranging node resolves anchor / camera mounts and the robot pose from
-// tf and feeds this class; the offline experiment runner feeds it directly.
+// UWB ranges from anchors on a robot to the picker's tags -> per tag a Range Histogram Filter (Sarmento et al.
+// 2024) -> identifying Observation; or, as an alternative input, the two-antenna range + phase-difference
+// relative position (Periotto and Sartori). ROS-free: the uwb_ranging node resolves anchor / camera mounts and
+// the robot pose from tf and feeds this class; the offline experiment runner feeds it directly.
 #pragma once
 
 #include <yaml-cpp/yaml.h>
@@ -24,7 +24,7 @@
 namespace picker_localisation {
 namespace sensors {
 
-// Seed 002 (after the PDoA patent it cites): relative position of a tag from the range r to antenna 1 and
+// Periotto and Sartori (after the PDoA patent it cites): relative position of a tag from the range r to antenna 1 and
 // the path difference p = r - r2 to antenna 2, antennas d apart on the x axis (antenna 1 at the origin):
 //   x = (d^2 + 2 r p - p^2) / (2 d),  y = +sqrt(r^2 - x^2) (the sign of y is ambiguous; `positive_y` picks it).
 // nullopt when d <= 0, r < 0, |p| > d (no geometry) or any input is not finite. r^2 < x^2 (noise) gives y = 0.
@@ -54,13 +54,14 @@ const char* toString(UwbRejection r);
 struct UwbRangingOptions {
   std::string sensor = "uwb";
   RhfOptions rhf;
-  // m, longer ranges are rejected (seed 004 Sec. 5.1 uses 12 m). Keep it below the grid's half size minus the
-  // anchor offsets: a person beyond the grid edge cannot be represented (the default suits the 20 m grid).
+  // m, longer ranges are rejected (Sarmento et al. 2024, Sec. 5.1 uses 12 m). Keep it below the grid's half
+  // size minus the anchor offsets: a person beyond the grid edge cannot be represented (the default suits the
+  // 20 m grid).
   double max_range = 9.5;
   double batch_window = 0.1;      // s, ranges of one tag within this window form one RHF update
   double bearing_max_age = 0.2;   // s, camera bearings older than this (vs the batch stamp) are not used
   // pdoa_mode: "ignore" (RHF on ranges only), "bearing" (a PDoA angle becomes a bearing in the RHF), or
-  // "direct" (seed 002 relative position -> observation, bypassing the RHF for that range).
+  // "direct" (Periotto and Sartori relative position -> observation, bypassing the RHF for that range).
   std::string pdoa_mode = "bearing";
   double pdoa_angle_sigma = 0.17; // rad (~10 deg)
   double min_sigma = 0.3;         // m, floor of the node likelihood's sigma

@@ -1,4 +1,4 @@
-// Cluster tracking across scans: seed 003 Algorithm 1 (hit/miss hysteresis: a track is confirmed after T_a
+// Cluster tracking across scans: Antonucci 2022 Algorithm 1 (hit/miss hysteresis: a track is confirmed after T_a
 // updates and removed after T_o scans without one) with the Munkres assignment of Sec. 6.3.3 in place of
 // Algorithm 1's first-match loop, and a distance gate d_min. Positions are in one fixed frame (the node
 // transforms to map/odom first, which is Algorithm 4's RotoTranslate step). ROS-free, deterministic.

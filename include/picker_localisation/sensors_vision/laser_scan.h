@@ -1,4 +1,4 @@
-// Jump-distance segmentation of 2D laser scans (core::LaserScan) (seed 003, Sec. 3.4.1 / 6.3.3, Algorithm 3).
+// Jump-distance segmentation of 2D laser scans (core::LaserScan) (Antonucci 2022, Sec. 3.4.1 / 6.3.3, Algorithm 3).
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 // The LiDAR people pipeline of one robot, as the leg_detector node runs it and as the offline runner
-// (`experiment`) runs it: scan -> clusters (seed 003 Alg. 3) -> leg classifier -> people -> one cluster
+// (`experiment`) runs it: scan -> clusters (Antonucci 2022, Alg. 3) -> leg classifier -> people -> one cluster
 // tracker PER SENSOR FRAME (Alg. 1 hysteresis; a laser that cannot see a person must not count a miss of the
 // other laser's track) -> optional camera fusion (Alg. 4) -> people -> non-identifying Observations.
 // ROS-free: the caller resolves the sensor pose (tf in the node, the simulated mount in the runner) and the

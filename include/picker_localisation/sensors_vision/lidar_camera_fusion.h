@@ -1,4 +1,4 @@
-// LiDAR-camera fusion (seed 003 Sec. 3.4.2 and Algorithm 4): each camera box spans a bearing cone in the LiDAR
+// LiDAR-camera fusion (Antonucci 2022, Sec. 3.4.2 and Algorithm 4): each camera box spans a bearing cone in the LiDAR
 // plane; the nearest cluster inside the cone is labelled a person. A cluster track matched by a cone for
 // `promote_after` frames is promoted (Algorithm 4's pm > m_p) and keeps that status while LiDAR alone tracks
 // it; after `demote_after` consecutive camera frames that do not match it (fm > m_r) it is demoted.

@@ -1,5 +1,5 @@
 // Munkres (Hungarian) assignment for rectangular cost matrices (OpenCV has none). Used by the cluster tracker
-// (seed 003 Sec. 6.3.3, Algorithm 4 line 2). ROS-free.
+// (Antonucci 2022, Sec. 6.3.3, Algorithm 4 line 2). ROS-free.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 // Monocular person detection (OpenCV HOG people detector by default, optional ONNX model through cv::dnn) and
-// the bearing of a box from the camera intrinsics (seed 004 Eq. 1). ROS-free.
+// the bearing of a box from the camera intrinsics (Sarmento et al. 2024, Eq. 1). ROS-free.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -111,9 +111,10 @@ struct CameraIntrinsics {
   int width = 0;
 };
 
-// Seed 004 Eq. 1: theta = atan(2 dx tan(f_w / 2) / w), dx the horizontal offset of the pixel column from the
-// image centre. With the pinhole model tan(f_w / 2) = (w / 2) / f_x and the centre at the principal point c_x,
-// this is theta = atan((c_x - u) / f_x). Sign: REP 103 body convention, positive to the LEFT (u < c_x).
+// Sarmento et al. 2024, Eq. 1: theta = atan(2 dx tan(f_w / 2) / w), dx the horizontal offset of the pixel
+// column from the image centre. With the pinhole model tan(f_w / 2) = (w / 2) / f_x and the centre at the
+// principal point c_x, this is theta = atan((c_x - u) / f_x). Sign: REP 103 body convention, positive to the
+// LEFT (u < c_x).
 double bearingFromColumn(double u, const CameraIntrinsics& k);
 double bearingFromBox(const cv::Rect& box, const CameraIntrinsics& k);  // bearing of the box's centre column
 // Eq. 1 in its field-of-view form (no principal point: the image centre w/2 is used).

@@ -1,6 +1,6 @@
 // Where a simulated robot's sensors sit on its base. The defaults mirror config/robot/thorvald.urdf.in (a
 // Thorvald-like 1.5 m x 1.4 m base; two 2D lasers at opposite corners facing out diagonally; two RFID
-// antennas facing the lanes on either side; two cameras and three UWB anchors as in seed 004 Table 1). The
+// antennas facing the lanes on either side; two cameras and three UWB anchors as in Sarmento et al. 2024, Table 1). The
 // lead may fill it from the URDF (robot::RobotDescription); frame names are the URDF link names without the
 // robot prefix. ROS-free.
 #pragma once

@@ -102,7 +102,7 @@ bool simulateUwbRange(const UwbParams& params, double distance, std::mt19937_64&
 // person_width x person_height standing on the ground, facing the camera. A box is produced when the picker's
 // centre is in front, within max_range and its bearing inside the horizontal field of view, with probability
 // 1 - p_miss; its edges get N(0, pixel_std^2) noise and are clipped to the image; the reported bearing is
-// that of the noisy box centre (seed 004 Eq. 1: atan((cx - u) / fx)). No occlusion between pickers is
+// that of the noisy box centre (Sarmento et al. 2024, Eq. 1: atan((cx - u) / fx)). No occlusion between pickers is
 // modelled.
 struct CameraParams {
   int image_width = 640;    // px

@@ -73,8 +73,8 @@ struct TpfParams {
   // 1/s, rate at which a particle turns round (velocity negated) between nodes, for pickers who walk back
   // along the lane (Table I p_reverse); 0: only lane ends and corners turn a particle (paper).
   double reverse_rate = 0.01;
-  // Lane-change structure of the farm (not in the paper; seed 000 Sec. VI: pickers walk on into the adjacent
-  // lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
+  // Lane-change structure of the farm (not in the paper; Polvara et al. 2021, Sec. VI: pickers walk on into the
+  // adjacent lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
   // non-lane nodes to the nearest end of the adjacent lane on each side (at most lane_change_max_hops hops).
   // A particle that leaves its lane at an end takes one of these paths (the one its jump started on, else
   // one at random); while on it, its next jump follows the path with weight 1 against lane_change_leak for
@@ -91,7 +91,7 @@ struct TpfParams {
   // each side equally likely.
   double lane_change_keep_side = 0.8;
 
-  // --- GNSS bias per particle (not in the paper; Khan et al., seed 001 Sec. VI) ----------------------------
+  // --- GNSS bias per particle (not in the paper; Khan et al. 2020 Sec. VI) ----------------------------
   // A phone's fix is wrong by an almost constant 2-5 m: its errors are one slowly drifting bias, not
   // independent draws. Fusing N fixes as independent (Eq. 8 literal) counts that one bias N times, so a bias
   // of a lane spacing outvotes the lane carried by the motion model within a minute (mid-lane splits, lane
