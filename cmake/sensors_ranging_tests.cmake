@@ -26,3 +26,11 @@ if(TARGET tpf_tracker)
   target_link_libraries(test_lcas_map picker_localisation_sensors_ranging_ros)
   add_dependencies(test_lcas_map gnss_ingest tpf_tracker)
 endif()
+
+# rostest: tpf_tracker and gnss_ingest on a network shared with strangers: bad service requests and bad
+# messages on every input are refused with a reply or one log line, every node stays up, beliefs keep coming.
+if(TARGET tpf_tracker)
+  add_rostest_gtest(test_hostile_inputs test/hostile_inputs.test test/test_hostile_inputs.cpp)
+  target_link_libraries(test_hostile_inputs picker_localisation_sensors_ranging_ros)
+  add_dependencies(test_hostile_inputs gnss_ingest tpf_tracker)
+endif()

@@ -79,7 +79,7 @@ expect_fatal gnss_ingest association_min_probability 0.3 "association_min_probab
   "${common_gnss[@]}"
 expect_warning gnss_ingest association_min_probabilty \
   "unknown key 'association_min_probabilty' (did you mean 'association_min_probability'?)" "${common_gnss[@]}"
-expect_fatal tpf_tracker num_particles 0 "num_particles = 0: must be > 0" "${common_tpf[@]}"
+expect_fatal tpf_tracker num_particles 0 "num_particles = 0: must be in .1, 100000." "${common_tpf[@]}"
 expect_warning tpf_tracker num_particle "unknown key 'num_particle' (did you mean 'num_particles'?)" "${common_tpf[@]}"
 # The other front-ends: the FATAL line (their unknown-key warnings come from the same core::unknownKeys).
 expect_fatal uwb_ranging p_min_uwb 2 "p_min_uwb = 2: must be in (0, 1\]" "${common_tpf[@]}"

@@ -107,6 +107,14 @@ TEST(PickerRegistry, IdsTagsAndRunTimeChanges) {
   EXPECT_NE(pickerIdProblem("1st"), "");
   EXPECT_NE(pickerIdProblem("bad-id"), "");
   EXPECT_NE(pickerIdProblem("a/b"), "");
+  EXPECT_EQ(pickerIdProblem("p" + std::string(kMaxPickerIdLength - 1, 'x')), "");
+  const std::string long_problem = pickerIdProblem("p" + std::string(10000, 'x'));
+  EXPECT_NE(long_problem.find("longer than 64"), std::string::npos) << long_problem;
+  EXPECT_LT(long_problem.size(), 200u) << "the whole id quoted";
+  // One GNSS device per picker: two pickers on one topic would each take the other's fixes.
+  EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, gnss_topic: /f}, {id: b, gnss_topic: /f}]"),
+               std::runtime_error);
+  EXPECT_NO_THROW(PickerRegistry::parse("pickers: [{id: a, gnss_topic: ''}, {id: b, gnss_topic: ''}]"));
   EXPECT_THROW(PickerRegistry::parse("pickers: [{id: bad-id}]"), std::runtime_error);
   EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, rfid_tags: ['']}]"), std::runtime_error);
   EXPECT_THROW(PickerRegistry::parse("pickers: [{id: a, tpf: 3}]"), std::runtime_error);

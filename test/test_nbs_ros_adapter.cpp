@@ -35,6 +35,15 @@ TEST(NbsRosAdapter, MassesFromBeliefRejectsUnknownNodesAndBadMasses) {
   b.masses = {1.0, 2.0};
   EXPECT_TRUE(ros_adapter::massesFromBelief(b, *map, &rejected).empty());
   EXPECT_EQ(rejected, 2u);
+  // Masses near the double's range sum to infinity: still a distribution, not all zero.
+  b.nodes = {"r0_1", "r1_2"};
+  b.masses = {1e308, 1e308};
+  const nbs::NodeMasses huge = ros_adapter::massesFromBelief(b, *map, &rejected);
+  ASSERT_EQ(huge.size(), map->numNodes());
+  EXPECT_NEAR(huge[*map->index("r0_1")], 0.5, 1e-12);
+  EXPECT_NEAR(huge[*map->index("r1_2")], 0.5, 1e-12);
+  b.nodes = {"r0_1", "r0_1"};  // one node at 2e308: infinite, refused
+  EXPECT_TRUE(ros_adapter::massesFromBelief(b, *map, &rejected).empty());
 }
 
 TEST(NbsRosAdapter, WhatIfSourceFallsBackToThePublishedBelief) {

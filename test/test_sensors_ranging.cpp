@@ -1069,6 +1069,11 @@ TEST(PickerAssociation, ClearDetectionsIdentifyAmbiguousOnesStayAnonymous) {
   const std::vector<BeliefView> lagged = beliefViews({h}, 3.5, o);  // lag 2 s: the belief of 1.0
   ASSERT_EQ(lagged.size(), 1u);
   EXPECT_DOUBLE_EQ(lagged[0].stamp, 1.0);
+  // Bounded in count whatever the rate (a tracker predicting at 1 MHz): the newest are kept.
+  BeliefHistory fast;
+  for (int k = 0; k < 5000; ++k) fast.push(1e-4 * k, sure, one);
+  EXPECT_EQ(fast.size(), BeliefHistory::kMaxItems);
+  EXPECT_DOUBLE_EQ(fast.atOrBefore(1.0).stamp, 1e-4 * 4999);
 
   // Identifying observations, observations without a position and association switched off pass unchanged.
   core::Observation id = f.person(1.4, {0.0, 1.5});

@@ -726,6 +726,12 @@ TEST(TpfParamsTest, PresetsAndErrors) {
   EXPECT_EQ(g.gammaFor("sonar").node, 0.5);
   EXPECT_EQ(g.gammaFor("gnss").velocity, 1.0);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{num_particles: many}")), std::runtime_error);
+  // Bounds a farm can afford: the largest allowed values pass, one more does not.
+  EXPECT_NO_THROW(TpfParams::fromYaml(
+      YAML::Load("{num_particles: 100000, prediction_rate: 10, lane_change_max_hops: 50}")));
+  EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{num_particles: 100001}")), std::runtime_error);
+  EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{prediction_rate: 10.5}")), std::runtime_error);
+  EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{lane_change_max_hops: 51}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{jsd_threshold: 2.0}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{resampling: stratified}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{method: nope}")), std::runtime_error);

@@ -72,6 +72,11 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   if (obs.velocity && !obs.velocity->allFinite()) return "velocity is not finite";
   if (obs.position && (!obs.position->allFinite() || !obs.position_covariance.allFinite()))
     return "position or its covariance is not finite";
+  if (obs.position) {
+    const Eigen::Matrix2d& c = obs.position_covariance;
+    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) + 1e-12)
+      return "position covariance is not positive semi-definite";
+  }
   if (obs.bias_removed) {
     const Eigen::Matrix2d& c = obs.bias_covariance;
     if (!obs.bias_removed->allFinite() || !c.allFinite()) return "bias or its covariance is not finite";

@@ -17,8 +17,16 @@ namespace {
 }
 }  // namespace
 
+std::string clippedForLog(const std::string& text, std::size_t max_chars) {
+  if (text.size() <= max_chars) return text;
+  return text.substr(0, max_chars) + "...(" + std::to_string(text.size()) + " chars)";
+}
+
 std::string pickerIdProblem(const std::string& id) {
   if (id.empty()) return "the id is empty";
+  if (id.size() > kMaxPickerIdLength)
+    return "id '" + clippedForLog(id) + "' is longer than " + std::to_string(kMaxPickerIdLength) +
+           " characters";
   if (!std::isalpha(static_cast<unsigned char>(id[0])))
     return "id '" + id + "' must start with a letter (it names topics /pickers/<id>/...)";
   for (char c : id)
@@ -29,7 +37,7 @@ std::string pickerIdProblem(const std::string& id) {
 
 PickerRegistry::PickerRegistry(std::vector<PickerConfig> pickers, const std::string& source)
     : pickers_(std::move(pickers)) {
-  std::unordered_map<std::string, std::string> ids, rfid, uwb;
+  std::unordered_map<std::string, std::string> ids, rfid, uwb, gnss;
   for (const PickerConfig& p : pickers_) {
     const std::string id_problem = pickerIdProblem(p.id);
     if (!id_problem.empty()) fail(source, id_problem + " (field 'id')");
@@ -37,11 +45,22 @@ PickerRegistry::PickerRegistry(std::vector<PickerConfig> pickers, const std::str
     for (const std::string& t : p.rfid_tags) {
       if (t.empty()) fail(source, "picker '" + p.id + "' has an empty RFID tag (field 'rfid_tags')");
       auto [it, fresh] = rfid.emplace(t, p.id);
-      if (!fresh) fail(source, "RFID tag '" + t + "' belongs to both '" + it->second + "' and '" + p.id + "' (field 'rfid_tags')");
+      if (!fresh)
+        fail(source, "RFID tag '" + clippedForLog(t) + "' belongs to both '" + it->second + "' and '" + p.id +
+                         "' (field 'rfid_tags')");
     }
     if (!p.uwb_tag.empty()) {
       auto [it, fresh] = uwb.emplace(p.uwb_tag, p.id);
-      if (!fresh) fail(source, "UWB tag '" + p.uwb_tag + "' belongs to both '" + it->second + "' and '" + p.id + "' (field 'uwb_tag')");
+      if (!fresh)
+        fail(source, "UWB tag '" + clippedForLog(p.uwb_tag) + "' belongs to both '" + it->second + "' and '" +
+                         p.id + "' (field 'uwb_tag')");
+    }
+    // One device per picker: two pickers on one fix topic would each take the other's fixes as their own.
+    if (!p.gnss_topic.empty()) {
+      auto [it, fresh] = gnss.emplace(p.gnss_topic, p.id);
+      if (!fresh)
+        fail(source, "GNSS topic '" + clippedForLog(p.gnss_topic) + "' belongs to both '" + it->second +
+                         "' and '" + p.id + "' (field 'gnss_topic')");
     }
   }
 }
@@ -112,7 +131,7 @@ std::optional<std::string> PickerRegistry::pickerForUwbTag(const std::string& ta
 }
 
 void PickerRegistry::add(PickerConfig picker) {
-  const std::string source = "picker '" + picker.id + "'";
+  const std::string source = "picker '" + clippedForLog(picker.id) + "'";
   std::vector<PickerConfig> all = pickers_;
   all.push_back(std::move(picker));
   *this = PickerRegistry(std::move(all), source);

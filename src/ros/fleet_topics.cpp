@@ -11,29 +11,56 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+std::string gnssTopicProblem(const std::string& topic) {
+  if (topic.empty()) return "";
+  // A private name means a different topic in every node that resolves it (the tracker's ~fix is not
+  // gnss_ingest's), and roscpp refuses it on a public NodeHandle.
+  if (topic[0] == '~')
+    return "gnss_topic '" + core::clippedForLog(topic) +
+           "': a private (~) name; give a global or relative name";
+  std::string error;
+  if (!ros::names::validate(topic, error)) return "gnss_topic: " + core::clippedForLog(error);
+  return "";
+}
+
 ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
                                  std::function<void(const core::PickerRegistry&)> apply) {
-  std::string topic;
+  std::string topic, publisher;
   pnh.param<std::string>("registry_topic", topic, "/pickers/registry");
   if (topic.empty()) return ros::Subscriber();
+  // Only the tracker's list: any node may publish on the topic, and one empty list from a stranger would drop
+  // every picker's GNSS subscription.
+  pnh.param<std::string>("registry_publisher", publisher, "/tpf_tracker");
+  if (!publisher.empty()) publisher = ros::names::resolve(publisher);
   const std::string name = node;
   return nh.subscribe<picker_localisation::PickerList>(
-      topic, 2, [name, apply](const picker_localisation::PickerList::ConstPtr& msg) {
-        std::vector<core::PickerConfig> pickers;
-        std::string problem;
-        for (const auto& info : msg->pickers) {
-          pickers.push_back(fromMsg(info));
-          std::string error;
-          if (!info.gnss_topic.empty() && !ros::names::validate(info.gnss_topic, error))
-            problem = "picker '" + info.id + "': gnss_topic: " + error;
-        }
-        try {
-          if (!problem.empty()) throw std::runtime_error(problem);
-          apply(core::PickerRegistry(std::move(pickers), "picker list"));
-        } catch (const std::exception& e) {
-          ROS_WARN("%s: picker list ignored (the previous one stays): %s", name.c_str(), e.what());
-        }
-      });
+      topic, 2,
+      boost::function<void(const ros::MessageEvent<picker_localisation::PickerList const>&)>(
+          [name, publisher, apply](const ros::MessageEvent<picker_localisation::PickerList const>& event) {
+            if (!publisher.empty() && event.getPublisherName() != publisher) {
+              ROS_WARN_THROTTLE(10.0,
+                                "%s: picker list from %s ignored: only %s's lists are followed "
+                                "(~registry_publisher)",
+                                name.c_str(), core::clippedForLog(event.getPublisherName()).c_str(),
+                                publisher.c_str());
+              return;
+            }
+            const picker_localisation::PickerList& msg = *event.getConstMessage();
+            std::vector<core::PickerConfig> pickers;
+            std::string problem;
+            for (const auto& info : msg.pickers) {
+              pickers.push_back(fromMsg(info));
+              const std::string topic_problem = gnssTopicProblem(info.gnss_topic);
+              if (!topic_problem.empty())
+                problem = "picker '" + core::clippedForLog(info.id) + "': " + topic_problem;
+            }
+            try {
+              if (!problem.empty()) throw std::runtime_error(problem);
+              apply(core::PickerRegistry(std::move(pickers), "picker list"));
+            } catch (const std::exception& e) {
+              ROS_WARN("%s: picker list ignored (the previous one stays): %s", name.c_str(), e.what());
+            }
+          }));
 }
 
 FleetBeliefs::FleetBeliefs(ros::NodeHandle& nh, ros::NodeHandle& pnh, Callback on_belief)

@@ -84,11 +84,16 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   pnh.param("people_pose_sigma", people_pose_sigma_, people_pose_sigma_);
   pnh.param<std::string>("pose_sensor", pose_sensor_, pose_sensor_);
   pnh.param<std::string>("pose_topic_format", pose_topic_format_, "");
+  int max_people = static_cast<int>(max_people_per_message_);
+  pnh.param("max_people_per_message", max_people, max_people);
   if (!(people_pose_sigma_ > 0.0) || !std::isfinite(people_pose_sigma_) || people_pose_sensor_.empty() ||
-      pose_sensor_.empty()) {
-    ROS_FATAL("gnss_ingest: people_pose_sigma must be > 0 and people_pose_sensor / pose_sensor non-empty");
+      pose_sensor_.empty() || max_people < 1) {
+    ROS_FATAL(
+        "gnss_ingest: people_pose_sigma and max_people_per_message must be > 0 and people_pose_sensor / "
+        "pose_sensor non-empty");
     return;
   }
+  max_people_per_message_ = static_cast<std::size_t>(max_people);
   for (const std::string& t : stringListParam(pnh, "people_pose_topics", {}))
     subs_.push_back(nh.subscribe<geometry_msgs::PoseArray>(
         t, 20, [this, t](const geometry_msgs::PoseArray::ConstPtr& m) { onPeoplePoses(m, t); }));
@@ -110,17 +115,28 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   ok_ = true;
 }
 
-void GnssIngestNode::addPicker(const core::PickerConfig& p) {
-  if (p.gnss_topic.empty()) return;
-  pickers_.push_back(std::make_unique<Picker>(p, map_, *datum_, options_));
-  Picker* raw = pickers_.back().get();
+bool GnssIngestNode::addPicker(const core::PickerConfig& p) {
+  if (p.gnss_topic.empty()) return true;
+  // Made whole before it is listed: a picker is either subscribed and counted, or not there at all.
+  auto picker = std::make_unique<Picker>(p, map_, *datum_, options_);
+  Picker* raw = picker.get();
+  try {
+    const std::string problem = gnssTopicProblem(p.gnss_topic);
+    if (!problem.empty()) throw std::runtime_error(problem);
+    raw->fix_sub = nh_.subscribe<sensor_msgs::NavSatFix>(
+        p.gnss_topic, 50, [this, raw](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, raw); },
+        ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
+    raw->bias_topic = nh_.resolveName(bias_prefix_ + "/" + p.id + "/gnss_bias");
+  } catch (const std::exception& e) {
+    ++pickers_refused_;
+    ROS_WARN("gnss_ingest: picker %s not followed: %s", p.id.c_str(), e.what());
+    return false;
+  }
+  pickers_.push_back(std::move(picker));
   by_id_[p.id] = raw;
-  raw->fix_sub = nh_.subscribe<sensor_msgs::NavSatFix>(
-      p.gnss_topic, 50, [this, raw](const sensor_msgs::NavSatFix::ConstPtr& m) { onFix(m, raw); },
-      ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay());
-  raw->bias_topic = nh_.resolveName(bias_prefix_ + "/" + p.id + "/gnss_bias");
   advertiseBias(*raw);
   ROS_INFO("gnss_ingest: %s <- %s", p.id.c_str(), p.gnss_topic.c_str());
+  return true;
 }
 
 void GnssIngestNode::advertiseBias(Picker& p) {
@@ -150,10 +166,7 @@ void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
     }
   }
   for (const std::string& id : order)
-    if (!by_id_.count(id) && !wanted[id].gnss_topic.empty()) {
-      addPicker(wanted[id]);
-      ++added;
-    }
+    if (!by_id_.count(id) && !wanted[id].gnss_topic.empty() && addPicker(wanted[id])) ++added;
   if (beliefs_) beliefs_->follow(order);
   followPoseTopics(order);
   if (added + removed > 0)
@@ -279,14 +292,36 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
   diagnostics_.tick("beliefs");
   const auto it = by_id_.find(msg.picker_id);
   if (it == by_id_.end()) return;  // a picker without GNSS here
+  if (msg.nodes.empty()) return;   // not initialised yet (or reset): nothing to associate with
+  // Kept beliefs are used by stamp: one from the future would hide every later belief of the picker.
+  if (stamp_guard_.tooFarInFuture(msg.header.stamp) || msg.nodes.size() > map_->numNodes()) {
+    ++bad_beliefs_;
+    ROS_WARN_THROTTLE(
+        10.0, "gnss_ingest: belief of %s dropped: stamped %.3f (more than %.1f s ahead) or %zu nodes",
+        msg.picker_id.c_str(), msg.header.stamp.toSec(), stamp_guard_.maxFuture(), msg.nodes.size());
+    return;
+  }
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
+  double peak = 0.0;
   for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k) {
     const auto n = map_->index(msg.nodes[k]);
     if (!n || !std::isfinite(msg.masses[k]) || msg.masses[k] < 0.0) continue;
     nodes.push_back(*n);
     masses.push_back(msg.masses[k]);
+    peak = std::max(peak, msg.masses[k]);
   }
+  if (!(peak > 0.0)) {
+    ++bad_beliefs_;
+    ROS_WARN_THROTTLE(10.0, "gnss_ingest: belief of %s dropped: no node of this map with a positive mass",
+                      msg.picker_id.c_str());
+    return;
+  }
+  // Normalised through the largest mass first, so masses near the double's range ([1e308, 1e308]) do not sum
+  // to infinity and become all zero.
+  double total = 0.0;
+  for (double& m : masses) total += (m /= peak);
+  for (double& m : masses) m /= total;
   it->second->beliefs.push(msg.header.stamp.toSec(), nodes, masses);
 }
 
@@ -315,11 +350,23 @@ bool GnssIngestNode::inMapFrame(const std::string& frame, const char* what) {
 void GnssIngestNode::onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg, const std::string& topic) {
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp) || !inMapFrame(msg->header.frame_id, "people poses")) return;
-  std::size_t k = 0;
+  if (msg->poses.size() > max_people_per_message_) {
+    // Not a crowd a robot sees: a broken or hostile detector. Refused whole, so it moves no belief.
+    bad_people_ += msg->poses.size();
+    ++people_arrays_refused_;
+    ROS_WARN_THROTTLE(5.0,
+                      "gnss_ingest: %zu people in one message on %s, more than ~max_people_per_message %zu: "
+                      "dropped",
+                      msg->poses.size(), topic.c_str(), max_people_per_message_);
+    return;
+  }
+  std::size_t k = 0, dropped = 0;
   for (const auto& pose : msg->poses) {
     const Eigen::Vector2d at(pose.position.x, pose.position.y);
-    if (!at.allFinite()) {
+    if (!at.allFinite() ||
+        (options_.max_map_distance > 0.0 && map_->distanceToNearestNode(at) > options_.max_map_distance)) {
       ++bad_people_;
+      ++dropped;
       continue;
     }
     core::Observation person;  // anonymous, as a leg_detector's person
@@ -330,10 +377,16 @@ void GnssIngestNode::onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg
     core::setGaussianLikelihood(person, *map_, at, person.position_covariance);
     if (person.empty()) {
       ++bad_people_;  // off the map
+      ++dropped;
       continue;
     }
     acceptPerson(std::move(person), topic + "|" + std::to_string(k++));
   }
+  if (dropped > 0)
+    ROS_WARN_THROTTLE(5.0,
+                      "gnss_ingest: %zu of %zu people on %s dropped: position not finite or farther than "
+                      "max_map_distance %.0f m from the map",
+                      dropped, msg->poses.size(), topic.c_str(), options_.max_map_distance);
 }
 
 void GnssIngestNode::followPoseTopics(const std::vector<std::string>& ids) {
@@ -360,6 +413,14 @@ void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped
     ++bad_poses_;
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: pose of %s dropped: position or covariance not finite / not PSD",
                       picker.c_str());
+    return;
+  }
+  if (options_.max_map_distance > 0.0 && map_->distanceToNearestNode(at) > options_.max_map_distance) {
+    // As a fix's check: a pose far off the map would be snapped to its nearest node and re-initialise there.
+    ++bad_poses_;
+    ROS_WARN_THROTTLE(
+        5.0, "gnss_ingest: pose of %s dropped: %.0f m from the nearest map node (max_map_distance %.0f m)",
+        picker.c_str(), map_->distanceToNearestNode(at), options_.max_map_distance);
     return;
   }
   core::Observation obs;
@@ -503,6 +564,9 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
            std::to_string(people_) + " / " + std::to_string(identified_) + " / " + std::to_string(nobody_) + " / " +
                std::to_string(bad_people_));
   stat.add("picker poses published / dropped", std::to_string(picker_poses_) + " / " + std::to_string(bad_poses_));
+  stat.add("people messages refused (over max_people_per_message)", people_arrays_refused_);
+  stat.add("beliefs dropped (future stamp, no valid mass)", bad_beliefs_);
+  stat.add("pickers refused (bad GNSS topic)", pickers_refused_);
   stat.add("waiting for stamp order", ordering_.size());
   stat.add("ordering latency (s)", ordering_latency_);
   stat.add("pickers with GNSS", pickers_.size());

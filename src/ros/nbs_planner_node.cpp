@@ -166,6 +166,11 @@ void NbsPlannerNode::beliefCallback(const picker_localisation::PickerBelief& msg
     return;
   }
   PickerInput& in = *found->second;
+  if (msg.nodes.empty() && msg.masses.empty()) {
+    // A new or reset picker's belief, "waiting for the first observation": nothing to plan on, nothing wrong.
+    in.belief.reset();
+    return;
+  }
   std::size_t rejected = 0;
   const nbs::NodeMasses masses = massesFromBelief(msg, *map_, &rejected);
   if (masses.empty()) {
@@ -290,6 +295,7 @@ void NbsPlannerNode::planOnce() {
       fallback = true;
       last_what_if_error_ = s->lastError();
     }
+  if (!fallback) last_what_if_error_.clear();  // a what-if problem of a picker since removed is not kept
   if (fallback) {
     ++fallback_plans_;
     ROS_WARN_THROTTLE(30.0, "%s: %s; planned with the published belief held still (no prediction)",

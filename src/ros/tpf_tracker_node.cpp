@@ -10,10 +10,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "picker_localisation/core/yaml_keys.h"
+#include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
-#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/observation_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
@@ -52,9 +54,13 @@ YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh) {
   return merged;
 }
 
-tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides) {
+tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides,
+                                      std::vector<std::string>* unknown) {
   YAML::Node merged = YAML::Clone(base);
   if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);
+  if (overrides.size() > kMaxOverridesChars)
+    throw std::runtime_error("tpf overrides: " + std::to_string(overrides.size()) +
+                             " characters, more than " + std::to_string(kMaxOverridesChars));
   if (!overrides.empty()) {
     YAML::Node o;
     try {
@@ -63,8 +69,20 @@ tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string&
       throw std::runtime_error("tpf overrides: YAML syntax error: " + e.msg);
     }
     if (!o.IsNull() && !o.IsMap()) throw std::runtime_error("tpf overrides must be a YAML mapping of config/tpf.yaml keys");
-    if (o.IsMap())
+    // Each key replaces the base's (a linear lookup): bounded, so a request cannot hold the tracker's only
+    // spinner for seconds. A mapping of every key of config/tpf.yaml fits twice over.
+    const std::size_t max_keys = 2 * tpf::TpfParams::yamlKeys().size();
+    if (o.IsMap() && o.size() > max_keys)
+      throw std::runtime_error("tpf overrides: " + std::to_string(o.size()) + " keys, more than " +
+                               std::to_string(max_keys) + " (config/tpf.yaml has " +
+                               std::to_string(tpf::TpfParams::yamlKeys().size()) + ")");
+    if (o.IsMap()) {
       for (const auto& kv : o) merged[kv.first.as<std::string>()] = kv.second;
+      // The same check as the file's keys at start-up: a typo is named, not silently ignored.
+      if (unknown)
+        for (auto& m : core::unknownKeys(o, tpf::TpfParams::yamlKeys(), "tpf overrides"))
+          unknown->push_back(std::move(m));
+    }
   }
   return tpf::TpfParams::fromYaml(merged);
 }
@@ -199,7 +217,8 @@ struct TpfTracker::Track {
   std::string current_node;                               // the last one published
   CountedPublisher markers_pub;
   ros::ServiceServer reset_srv, what_if_srv;
-  std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0;
+  std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0,
+                exceptions = 0;
   std::string last_problem;
   std::string belief_topic, estimate_topic, markers_topic, current_node_topic;  // resolved names ("": none)
 };
@@ -257,10 +276,12 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   const std::vector<core::PickerConfig> initial = registry_.pickers();
   for (const core::PickerConfig& p : initial) {
     std::string error;
-    if (!startTrack(p, &error)) {
+    std::vector<std::string> unknown;
+    if (!startTrack(p, &error, &unknown)) {
       ROS_FATAL("tpf_tracker: picker %s: %s", p.id.c_str(), error.c_str());
       return;
     }
+    for (const std::string& u : unknown) ROS_WARN("tpf_tracker: picker %s: %s", p.id.c_str(), u.c_str());
   }
   // The deployment's list (from a pickers file) is latched for gnss_ingest; one ~picker_id (tools, tests) names
   // no GNSS topic, so it publishes none.
@@ -292,19 +313,26 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
 
 TpfTracker::~TpfTracker() { ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<std::uint64_t>(this)); }
 
-bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error) {
+bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error,
+                            std::vector<std::string>* unknown) {
   tpf::TpfParams params;
+  auto t = std::make_unique<Track>();
+  Track* raw = t.get();
+  t->id = picker.id;
   try {
-    params = tpfParamsWithOverrides(base_params_, picker.tpf_overrides);
+    params = tpfParamsWithOverrides(base_params_, picker.tpf_overrides, unknown);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
   }
-  auto t = std::make_unique<Track>();
-  Track* raw = t.get();
-  t->id = picker.id;
-  const std::uint64_t seed = seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(picker.id);
-  t->filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
+  try {
+    const std::uint64_t seed =
+        seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(picker.id);
+    t->filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
+  } catch (const std::exception& e) {  // std::bad_alloc: this picker is refused, the others go on
+    *error = std::string("its filter could not be made: ") + e.what();
+    return false;
+  }
   t->prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 0.0;
   const std::string base = prefix_ + "/" + picker.id;
   t->belief_topic = nh_.resolveName(base + "/belief");
@@ -328,14 +356,21 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
       base + "/what_if", [this, raw](picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
         ++raw->what_if_calls;
         const tpf::TopologicalParticleFilter& f = *raw->filter;
-        if (!std::isfinite(req.horizon) || req.horizon < 0.0) {
+        if (!(req.horizon >= 0.0 && req.horizon <= kMaxWhatIfHorizon)) {
           res.success = false;
-          res.message = "horizon must be finite and >= 0";
+          res.message =
+              "horizon must be in [0, " + std::to_string(static_cast<int>(kMaxWhatIfHorizon)) + "] s";
+          ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: what_if refused: %s", raw->id.c_str(), res.message.c_str());
           return true;
         }
         tpf::Belief b;
         if (req.with_observation) {
           tpf::UpdateResult r;
+          if (req.observation.nodes.size() > map_->numNodes()) {
+            res.success = false;
+            res.message = "hypothetical observation has more nodes than the map";
+            return true;
+          }
           b = f.posteriorUnder(fromMsg(req.observation, *map_), req.horizon, req.seed, &r);
           if (!r.ok()) {
             res.success = false;
@@ -392,7 +427,13 @@ void TpfTracker::updatePredictionTimer() {
   for (const auto& kv : tracks_)
     if (kv.second->prediction_period > 0.0 && (fastest == 0.0 || kv.second->prediction_period < fastest))
       fastest = kv.second->prediction_period;
-  if (fastest <= 0.0 || fastest / 4.0 == timer_period_) return;
+  if (fastest <= 0.0) {  // no picker predicts periodically: no timer
+    prediction_timer_.stop();
+    prediction_timer_ = ros::Timer();
+    timer_period_ = 0.0;
+    return;
+  }
+  if (fastest / 4.0 == timer_period_) return;
   timer_period_ = fastest / 4.0;
   prediction_timer_ = nh_.createTimer(ros::Duration(timer_period_), &TpfTracker::predictionTick, this);
 }
@@ -432,6 +473,13 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
     ROS_WARN_THROTTLE(5.0, "tpf_tracker: %s observation for %s stamped %.3f is more than %.1f s ahead of the clock: dropped",
                       msg->sensor.c_str(), msg->identifying ? msg->picker_id.c_str() : "anyone",
                       msg->header.stamp.toSec(), stamp_guard_.maxFuture());
+    return;
+  }
+  if (msg->nodes.size() > map_->numNodes() || msg->likelihood.size() > map_->numNodes()) {
+    // A likelihood names each node at most once: a longer one is not an observation of this map.
+    ++oversized_;
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker: %s observation with %zu nodes dropped: the map has %zu",
+                      core::clippedForLog(msg->sensor).c_str(), msg->nodes.size(), map_->numNodes());
     return;
   }
   std::size_t unknown = 0;
@@ -495,8 +543,14 @@ void TpfTracker::predictDueUntil(Track& t, double until) {
 
 
 void TpfTracker::process(Track& t, const core::Observation& obs, const std::string& sensor) {
-  if (std::isfinite(obs.stamp)) predictDueUntil(t, obs.stamp);
-  const tpf::UpdateResult r = t.filter->update(obs);
+  tpf::UpdateResult r;
+  try {
+    if (std::isfinite(obs.stamp)) predictDueUntil(t, obs.stamp);
+    r = t.filter->update(obs);
+  } catch (const std::exception& e) {
+    caught(t, e);
+    return;
+  }
   if (!r.ok()) {
     if (r.status != tpf::UpdateStatus::kIgnoredSensor) {
       t.last_problem = std::string(tpf::toString(r.status)) + ": " + r.reason;
@@ -514,8 +568,26 @@ void TpfTracker::predictionTick(const ros::TimerEvent&) {
   const double now = ros::Time::now().toSec();
   if (now <= 0.0) return;  // sim clock not running yet
   // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
-  for (auto& kv : tracks_) predictDueUntil(*kv.second, now - ordering_latency_);
+  for (auto& kv : tracks_) {
+    try {
+      predictDueUntil(*kv.second, now - ordering_latency_);
+    } catch (const std::exception& e) {
+      caught(*kv.second, e);
+    }
+  }
   flush();
+}
+
+void TpfTracker::caught(Track& t, const std::exception& e) {
+  // Nothing a callback meets may stop the node (roscpp would end the process, and roslaunch the robot): the
+  // picker's belief is forgotten, the next observation initialises it again.
+  ++t.exceptions;
+  t.last_problem = std::string("exception: ") + e.what();
+  ROS_ERROR_THROTTLE(5.0, "tpf_tracker %s: %s; belief reset", t.id.c_str(), t.last_problem.c_str());
+  try {
+    t.filter->reset();
+  } catch (const std::exception&) {
+  }
 }
 
 void TpfTracker::publish(Track& t) {
@@ -594,39 +666,34 @@ void TpfTracker::publishRegistry() {
 bool TpfTracker::addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res) {
   core::PickerConfig p = fromMsg(req.picker);
   p.tpf_overrides = req.tpf_overrides;
-  std::string error;
-  if (!p.gnss_topic.empty() && !ros::names::validate(p.gnss_topic, error)) error = "gnss_topic: " + error;
+  std::string error = gnssTopicProblem(p.gnss_topic);
+  std::vector<std::string> unknown;
   core::PickerRegistry updated = registry_;
   if (error.empty()) {
     try {
-      updated.add(p);  // id rules, duplicates, tags worn by another picker
+      updated.add(p);  // id rules, duplicates, tags or a GNSS topic worn by another picker
     } catch (const std::exception& e) {
       error = e.what();
     }
   }
-  if (error.empty()) {
-    try {
-      tpfParamsWithOverrides(base_params_, p.tpf_overrides);
-    } catch (const std::exception& e) {
-      error = std::string("tpf_overrides: ") + e.what();
-    }
-  }
-  if (error.empty()) {
-    registry_ = updated;
-    if (!startTrack(p, &error)) registry_.remove(p.id);  // (parameters checked above: not expected)
-  }
+  if (error.empty()) startTrack(p, &error, &unknown);
   res.success = error.empty();
   if (!res.success) {
     ++refused_requests_;
-    res.message = "picker '" + p.id + "' not added: " + error;
+    res.message = "picker '" + core::clippedForLog(p.id) + "' not added: " + error;
     ROS_WARN("tpf_tracker: %s", res.message.c_str());
     return true;
   }
+  registry_ = updated;
   ++added_;
   updatePredictionTimer();
   publishRegistry();
   res.message = "tracking " + p.id + " (" + std::to_string(tracks_.size()) + " picker(s))";
-  ROS_INFO("tpf_tracker: %s", res.message.c_str());
+  for (const std::string& u : unknown) res.message += "; ignored " + u;
+  if (unknown.empty())
+    ROS_INFO("tpf_tracker: %s", res.message.c_str());
+  else
+    ROS_WARN("tpf_tracker: %s", res.message.c_str());
   return true;
 }
 
@@ -636,7 +703,8 @@ bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
   if (it == tracks_.end()) {
     ++refused_requests_;
     res.success = false;
-    res.message = "no picker '" + req.id + "' is tracked (list_pickers names them)";
+    res.message = "no picker '" + core::clippedForLog(req.id) + "' is tracked (list_pickers names them)";
+    ROS_WARN("tpf_tracker: remove_picker refused: %s", res.message.c_str());
     return true;
   }
   flush();  // nothing queued may outlive its track
@@ -648,6 +716,7 @@ bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
   tracks_.erase(it);  // its filter, publishers and services go with it
   registry_.remove(req.id);
   ++removed_;
+  updatePredictionTimer();  // a fast picker gone: the timer slows down (or stops) with it
   publishRegistry();
   res.success = true;
   res.message = "stopped tracking " + req.id + " (" + std::to_string(tracks_.size()) + " picker(s) left)";
@@ -670,6 +739,7 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("per-picker topics on demand", on_demand_.onDemand() ? "yes" : "no");
   stat.add("observations received", received_);
   stat.add("observations for no tracked picker", unrouted_);
+  stat.add("observations with more nodes than the map (dropped)", oversized_);
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("clock jumps back (beliefs reset)", stamp_guard_.jumps());
   stat.add("ordering latency (s)", ordering_latency_);
@@ -682,7 +752,7 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
 
 void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat) {
   const auto& c = t.filter->counters();
-  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old;
+  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old + t.exceptions;
   stat.hardware_id = t.id;
   stat.add("picker_id", t.id);
   stat.add("observations received", t.received);
@@ -693,6 +763,7 @@ void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper&
   stat.add("rejected (invalid)", c.rejected_invalid);
   stat.add("ignored (sensor not fused in this mode)", c.ignored_sensor);
   stat.add("unknown node names skipped", t.unknown_nodes);
+  stat.add("exceptions caught (belief reset)", t.exceptions);
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);
   stat.add("predictions", c.predictions);

@@ -2,6 +2,7 @@
 
 #include <picker_localisation/WhatIf.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "picker_localisation/ros/observation_conversions.h"
@@ -25,7 +26,12 @@ nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg,
     total += v;
   }
   if (rejected) *rejected = bad;
-  if (!(total > 0.0)) return {};
+  // Normalised through the largest mass first: masses near the double's range ([1e308, 1e308]) sum to
+  // infinity and would all become 0.
+  const double peak = m.empty() ? 0.0 : *std::max_element(m.begin(), m.end());
+  if (!(total > 0.0) || !std::isfinite(peak)) return {};
+  total = 0.0;
+  for (double& v : m) total += (v /= peak);
   for (double& v : m) v /= total;
   return m;
 }

@@ -40,6 +40,7 @@ void BeliefHistory::push(double stamp, const std::vector<topology::NodeIndex>& n
   if (!items_.empty() && stamp == items_.back().stamp) items_.pop_back();
   items_.push_back({stamp, nodes, masses});
   while (items_.size() > 1 && items_.front().stamp < stamp - horizon) items_.pop_front();
+  while (items_.size() > kMaxItems) items_.pop_front();  // beliefs faster than any tracker publishes
 }
 
 BeliefView BeliefHistory::atOrBefore(double t) const {

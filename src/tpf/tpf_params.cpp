@@ -44,7 +44,8 @@ bool TpfParams::usesBiasState(const std::string& sensor) const {
 
 std::string TpfParams::validate() const {
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
-  if (num_particles == 0) return core::badValue("num_particles", static_cast<double>(num_particles), "> 0");
+  if (num_particles == 0 || num_particles > kMaxParticles)
+    return core::badValue("num_particles", static_cast<double>(num_particles), "in [1, 100000]");
   if (!std::isfinite(velocity_init_mean) || !finite_nonneg(velocity_init_variance))
     return "velocity_init_mean / velocity_init_variance must be finite, variance >= 0";
   if (!std::isfinite(velocity_noise_mean) || !finite_nonneg(velocity_noise_variance))
@@ -60,8 +61,8 @@ std::string TpfParams::validate() const {
     return core::badValue("reinit_fraction", reinit_fraction, "in (0, 1]");
   if (!(lane_change_leak >= 0.0 && lane_change_leak <= 1.0))
     return core::badValue("lane_change_leak", lane_change_leak, "in [0, 1]");
-  if (lane_change_max_hops < 1)
-    return core::badValue("lane_change_max_hops", static_cast<double>(lane_change_max_hops), ">= 1");
+  if (lane_change_max_hops < 1 || lane_change_max_hops > kMaxLaneChangeHops)
+    return core::badValue("lane_change_max_hops", static_cast<double>(lane_change_max_hops), "in [1, 50]");
   if (!(lane_change_keep_side >= 0.0 && lane_change_keep_side <= 1.0))
     return core::badValue("lane_change_keep_side", lane_change_keep_side, "in [0, 1]");
   if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate))
@@ -86,8 +87,8 @@ std::string TpfParams::validate() const {
     return core::badValue("entropy_threshold", entropy_threshold, ">= 0");
   if (!(unconnected_jump_probability >= 0.0 && unconnected_jump_probability <= 1.0))
     return core::badValue("unconnected_jump_probability", unconnected_jump_probability, "in [0, 1]");
-  if (!(prediction_rate >= 0.0) || !std::isfinite(prediction_rate))
-    return core::badValue("prediction_rate", prediction_rate, ">= 0");
+  if (!(prediction_rate >= 0.0 && prediction_rate <= kMaxPredictionRate))
+    return core::badValue("prediction_rate", prediction_rate, "in [0, 10] Hz");
   if (!finite_nonneg(reorder_window)) return core::badValue("reorder_window", reorder_window, ">= 0");
   if (!(gnss_bias_fix_std > 0.0) || !std::isfinite(gnss_bias_fix_std))
     return core::badValue("gnss_bias_fix_std", gnss_bias_fix_std, "finite and > 0");

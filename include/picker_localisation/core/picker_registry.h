@@ -17,8 +17,11 @@ struct PickerConfig {
 };
 
 // "" when `id` can name a picker (it becomes a ROS name component: /pickers/<id>/belief, a tf frame):
-// a letter first, then letters, digits and '_'; else why not.
+// a letter first, then letters, digits and '_', at most kMaxPickerIdLength characters; else why not.
+constexpr std::size_t kMaxPickerIdLength = 64;
 std::string pickerIdProblem(const std::string& id);
+// `text` cut to `max_chars` with its length noted, for log lines and replies that quote what a caller sent.
+std::string clippedForLog(const std::string& text, std::size_t max_chars = 80);
 
 // Format:
 //   pickers:
@@ -28,7 +31,8 @@ std::string pickerIdProblem(const std::string& id);
 //       uwb_tag: uwb_0001
 //       tpf: {num_particles: 2000}   # optional overrides of config/tpf.yaml for this picker
 // Throws std::runtime_error with one line naming the file, the entry and the field on a bad file
-// (missing, invalid or duplicate id, an empty tag or one claimed by two pickers, wrong types).
+// (missing, invalid or duplicate id, an empty tag or one claimed by two pickers, a GNSS topic of two pickers,
+// wrong types).
 class PickerRegistry {
  public:
   static PickerRegistry load(const std::string& path);

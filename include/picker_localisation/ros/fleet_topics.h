@@ -17,9 +17,15 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+// "" when `topic` can be a picker's GNSS topic for every node ("" = none), else why not: a valid ROS name,
+// not a private (~) one. The tracker refuses such a picker, the followers such a list.
+std::string gnssTopicProblem(const std::string& topic);
+
 // Follows tpf_tracker's picker list (~registry_topic, default /pickers/registry; "" = never): each valid list
-// is handed to `apply`; an invalid one (bad id, duplicate, a tag on two pickers) is ignored with one warning
-// naming `node` and the reason, the previous list stays.
+// is handed to `apply`; an invalid one (bad id, duplicate, a tag or GNSS topic on two pickers, a bad GNSS
+// topic name) is ignored with one warning naming `node` and the reason, the previous list stays. Only lists
+// published by the node ~registry_publisher (default /tpf_tracker; "" any node) are followed: a list from
+// another node is ignored with a throttled warning naming it.
 ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
                                  std::function<void(const core::PickerRegistry&)> apply);
 

@@ -45,7 +45,8 @@ class GnssIngestNode {
     core::GnssFix fix;
     core::Observation person;
   };
-  void addPicker(const core::PickerConfig& p);
+  // Subscribes the picker's GNSS topic; false (a warning, nothing kept) when it cannot.
+  bool addPicker(const core::PickerConfig& p);
   void advertiseBias(Picker& p);
   void onRegistry(const core::PickerRegistry& registry);
   void onFix(const sensor_msgs::NavSatFix::ConstPtr& msg, Picker* picker);
@@ -91,7 +92,9 @@ class GnssIngestNode {
   ros::Timer ordering_timer_;
   NodeDiagnostics diagnostics_;
   std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
-  std::size_t picker_poses_ = 0, bad_poses_ = 0;
+  std::size_t picker_poses_ = 0, bad_poses_ = 0, people_arrays_refused_ = 0, bad_beliefs_ = 0,
+              pickers_refused_ = 0;
+  std::size_t max_people_per_message_ = 100;  // ~max_people_per_message: a larger PoseArray is refused whole
   std::string people_pose_sensor_ = "people", pose_sensor_ = "pose", pose_topic_format_;
   double people_pose_sigma_ = 0.3;
   std::map<std::string, ros::Subscriber> pose_subs_;  // picker id -> its PoseWithCovarianceStamped topic

@@ -86,9 +86,13 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& belief, const topol
 // The merged TPF parameters YAML of a private namespace: ~tpf_params_file (when set) as the base, then every
 // private parameter on top. Throws std::runtime_error naming the file on a YAML error.
 YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh);
-// `base` with a picker's overrides (YAML mapping text, "" none) on top. Throws std::runtime_error naming the
-// key on a bad value.
-tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides);
+// `base` with a picker's overrides (YAML mapping text, "" none) on top, through the same schema and bounds as
+// config/tpf.yaml (tpf::TpfParams::fromYaml). Throws std::runtime_error naming the key on a bad value, and on
+// overrides longer than kMaxOverridesChars or with more than twice as many keys as the file has. With
+// `unknown`, one message per override key that is not a config/tpf.yaml key, with the closest one.
+constexpr std::size_t kMaxOverridesChars = 16384;
+tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string& overrides,
+                                      std::vector<std::string>* unknown = nullptr);
 
 class TpfTracker {
  public:
@@ -110,8 +114,9 @@ class TpfTracker {
     core::Observation obs;
     std::string sensor;
   };
-  // Starts tracking a picker (already in registry_); false and *error when its parameters are bad.
-  bool startTrack(const core::PickerConfig& picker, std::string* error);
+  // Starts tracking a picker; false and *error, nothing changed, when its parameters are bad or its filter
+  // cannot be allocated. Unknown override keys are appended to *unknown.
+  bool startTrack(const core::PickerConfig& picker, std::string* error, std::vector<std::string>* unknown);
   // The tracks an observation concerns.
   std::vector<Track*> route(bool identifying, const std::string& picker_id, const std::vector<std::string>& candidates);
   void observationCallback(const picker_localisation::Observation::ConstPtr& msg);
@@ -133,6 +138,9 @@ class TpfTracker {
                     picker_localisation::RemovePicker::Response& res);
   bool listPickers(picker_localisation::ListPickers::Request& req, picker_localisation::ListPickers::Response& res);
   static constexpr int kMaxPredictionsPerCall = 100;  // a longer silence is bridged by one prediction
+  static constexpr double kMaxWhatIfHorizon = 3600.0;  // s: a planner asks seconds to minutes ahead
+  // An exception out of a picker's filter (std::bad_alloc): logged, counted, that belief reset.
+  void caught(Track& t, const std::exception& e);
   void diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat);
   // The clock jumped back (bag loop, simulator restart): every belief and the waiting observations are dropped
@@ -159,7 +167,7 @@ class TpfTracker {
   core::StampOrderedBuffer<Pending> ordering_;
   double ordering_latency_ = 0.0;
   NodeDiagnostics diagnostics_;
-  std::uint64_t received_ = 0, unrouted_ = 0, added_ = 0, removed_ = 0, refused_requests_ = 0;
+  std::uint64_t received_ = 0, unrouted_ = 0, added_ = 0, removed_ = 0, refused_requests_ = 0, oversized_ = 0;
   StampGuard stamp_guard_;
 };
 

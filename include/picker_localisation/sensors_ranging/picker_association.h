@@ -44,7 +44,9 @@ struct BeliefView {
 // keeps the same history, so both use the same belief.
 class BeliefHistory {
  public:
-  // Stores a copy when `stamp` is newer than the newest kept (an equal stamp replaces it); keeps `horizon` s.
+  // Stores a copy when `stamp` is newer than the newest kept (an equal stamp replaces it); keeps `horizon` s,
+  // and at most kMaxItems beliefs (the newest): 30 s of beliefs at 30 Hz, bounded whatever a tracker sends.
+  static constexpr std::size_t kMaxItems = 1000;
   void push(double stamp, const std::vector<topology::NodeIndex>& nodes, const std::vector<double>& masses,
             double horizon = 30.0);
   // The newest belief with stamp <= t (invalid view when none).

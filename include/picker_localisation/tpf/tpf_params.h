@@ -35,6 +35,14 @@ enum class ResamplingScheme {
 };
 
 struct TpfParams {
+  // Upper bounds a farm can afford, checked by validate() for the file and for a picker's run-time overrides
+  // alike: one picker's filter must not starve the others of a shared tracker. 100,000 particles are about
+  // 14 MB and 100 times the default's update time; predictions faster than 10 Hz only repeat what the
+  // observations (GNSS 1-10 Hz) tell; a lane-change path of 50 hops is longer than any farm's headland.
+  static constexpr std::size_t kMaxParticles = 100000;
+  static constexpr double kMaxPredictionRate = 10.0;  // Hz
+  static constexpr int kMaxLaneChangeHops = 50;
+
   // --- particles -----------------------------------------------------------------------------------------
   std::size_t num_particles = 1000;
   ResamplingScheme resampling = ResamplingScheme::kLowVariance;
