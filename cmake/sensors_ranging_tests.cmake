@@ -34,3 +34,11 @@ if(TARGET tpf_tracker)
   target_link_libraries(test_hostile_inputs picker_localisation_sensors_ranging_ros)
   add_dependencies(test_hostile_inputs gnss_ingest tpf_tracker)
 endif()
+
+# rostest: the running tracker and gnss_ingest fuzzed through the map topic (mutated maps) and the tracker's
+# services (random requests).
+if(TARGET tpf_tracker)
+  add_rostest_gtest(test_fuzz_nodes test/fuzz_nodes.test test/test_fuzz_nodes.cpp)
+  target_link_libraries(test_fuzz_nodes picker_localisation_sensors_ranging_ros)
+  add_dependencies(test_fuzz_nodes gnss_ingest tpf_tracker)
+endif()

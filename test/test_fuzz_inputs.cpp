@@ -18,6 +18,7 @@
 #include <random>
 #include <sstream>
 
+#include "fuzz_util.h"
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/ros/leg_detector_node.h"
@@ -33,6 +34,7 @@
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
 using namespace picker_localisation;
+using fuzz::Wild;
 
 namespace {
 
@@ -45,42 +47,6 @@ std::shared_ptr<const topology::TopologicalMap> riseholme() {
 }
 
 core::PickerRegistry registry() { return core::PickerRegistry::load(kPackage + "/config/pickers.yaml"); }
-
-// Random values a broken driver or a hostile publisher may send.
-struct Wild {
-  std::mt19937_64 rng;
-  explicit Wild(std::uint64_t seed) : rng(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
-  std::size_t index(std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng); }
-  bool chance(double p) { return uniform(0.0, 1.0) < p; }
-  // Mostly plausible (around `typical`, spread `spread`), sometimes pathological.
-  double value(double typical, double spread) {
-    switch (index(12)) {
-      case 0: return std::numeric_limits<double>::quiet_NaN();
-      case 1: return std::numeric_limits<double>::infinity();
-      case 2: return -std::numeric_limits<double>::infinity();
-      case 3: return 0.0;
-      case 4: return uniform(-1e300, 1e300);
-      case 5: return -typical - spread;
-      case 6: return std::numeric_limits<double>::denorm_min();
-      default: return typical + spread * std::normal_distribution<double>(0.0, 1.0)(rng);
-    }
-  }
-  std::size_t size(std::size_t typical) {  // 0, typical-ish, or large
-    switch (index(6)) {
-      case 0: return 0;
-      case 1: return 1;
-      case 2: return index(20 * typical + 1);
-      default: return index(2 * typical + 1);
-    }
-  }
-  std::string name(const std::vector<std::string>& known) {
-    if (!known.empty() && chance(0.7)) return known[index(known.size())];
-    std::string s(size(8), 'x');
-    for (char& c : s) c = static_cast<char>(index(256));
-    return s;
-  }
-};
 
 void expectValid(const core::Observation& o, const topology::TopologicalMap& map, const std::string& where) {
   EXPECT_EQ(core::validateObservation(o, map), "") << where;
@@ -339,28 +305,10 @@ TEST(Fuzz, MapTextIsAMapOrOneMapError) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string original = buffer.str();
-  const std::vector<std::string> tokens = {":", "-", "{", "}", "[", "]", "'", "\"", "&a", "*a", "!!binary", "\n",
-                                           "  ", "nodes:", "edges:", "node:", ".nan", "-.inf", "1e999", "~", "\t",
-                                           "<<: *a", "%YAML 1.2\n---\n", "\0"};
-  Wild w(8);
+  fuzz::Wild w(8);
   std::size_t parsed = 0, rejected = 0;
   for (int i = 0; i < 200; ++i) {
-    std::string text;
-    if (i % 10 == 9) {  // random bytes
-      text.resize(w.size(2000));
-      for (char& c : text) c = static_cast<char>(w.index(256));
-    } else {
-      text = original;
-      for (int k = static_cast<int>(w.index(4)); k >= 0; --k) {
-        const std::size_t at = w.index(text.size());
-        switch (w.index(4)) {
-          case 0: text.erase(at, w.index(200)); break;
-          case 1: text.insert(at, tokens[w.index(tokens.size())]); break;
-          case 2: text[at] = static_cast<char>(w.index(256)); break;
-          default: text.resize(at); break;
-        }
-      }
-    }
+    const std::string text = fuzz::mutantMapText(original, i, w);
     try {
       const topology::TopologicalMap map = topology::parseMap(text, "mutant_" + std::to_string(i));
       ++parsed;

@@ -6,6 +6,7 @@
 // diagnostics ERROR by every node, which stay up and take the valid map that follows.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <picker_localisation/PickerBelief.h>
 #include <ros/master.h>
 #include <ros/ros.h>
 #include <sensor_msgs/NavSatFix.h>
@@ -66,6 +67,38 @@ void writeJson(const YAML::Node& n, std::ostream& out) {
 }
 
 constexpr double kDatumLatitude = 52.1, kDatumLongitude = 1.2;  // not config/datum.yaml's
+
+// A map manager's edit of a tmap2 document: node `from` renamed `to` (its entry and every edge into it).
+void renameNode(YAML::Node& doc, const std::string& from, const std::string& to) {
+  for (YAML::Node n : doc["nodes"]) {
+    if (n["node"]["name"].as<std::string>() == from) {
+      n["node"]["name"] = to;
+      n["meta"]["node"] = to;
+    }
+    for (YAML::Node e : n["node"]["edges"])
+      if (e["node"].as<std::string>() == from) e["node"] = to;
+  }
+}
+// Node `name` removed with every edge into it.
+void removeNode(YAML::Node& doc, const std::string& name) {
+  YAML::Node kept(YAML::NodeType::Sequence);
+  for (YAML::Node n : doc["nodes"]) {
+    if (n["node"]["name"].as<std::string>() == name) continue;
+    YAML::Node edges(YAML::NodeType::Sequence);
+    for (const YAML::Node& e : n["node"]["edges"])
+      if (e["node"].as<std::string>() != name) edges.push_back(e);
+    n["node"]["edges"] = edges;
+    kept.push_back(n);
+  }
+  doc["nodes"] = kept;
+}
+std_msgs::String asJson(const YAML::Node& doc) {
+  std::ostringstream json;
+  writeJson(doc, json);
+  std_msgs::String text;
+  text.data = json.str();
+  return text;
+}
 
 }  // namespace
 
@@ -159,9 +192,91 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
     std::lock_guard<std::mutex> lock(m);
     reached = current == expected;
   }
+  {
+    std::lock_guard<std::mutex> lock(m);
+    ASSERT_EQ(current, expected) << "the picker stands at " << expected << " (" << p_map.transpose()
+                                 << " in the map frame)";
+  }
+
+  // The map manager edits the map while the picker is tracked: the picker's node renamed, two nodes of
+  // another lane removed, a third lane's nodes moved 0.4 m. Within seconds current_node names the renamed
+  // node (a node of the new map, where the picker stands), the belief keeps its mass there, no node restarts.
+  std::mutex belief_mutex;
+  picker_localisation::PickerBelief belief;
+  ros::Subscriber belief_sub = nh.subscribe<picker_localisation::PickerBelief>(
+      "/pickers/picker_1/belief", 5, [&](const picker_localisation::PickerBelief::ConstPtr& b) {
+        std::lock_guard<std::mutex> lock(belief_mutex);
+        belief = *b;
+      });
+  YAML::Node edited = YAML::Clone(doc);
+  const std::string renamed = expected + "_renamed";
+  renameNode(edited, expected, renamed);
+  const auto& far_lane = lcas_map.laneNodes(0);
+  for (std::size_t k = 0; k < 2; ++k) removeNode(edited, lcas_map.node(far_lane[k]).name);
+  const auto& moved_lane = lcas_map.laneNodes(1);
+  for (YAML::Node n : edited["nodes"])
+    for (topology::NodeIndex i : moved_lane)
+      if (n["node"]["name"].as<std::string>() == lcas_map.node(i).name)
+        n["node"]["pose"]["position"]["x"] = n["node"]["pose"]["position"]["x"].as<double>() + 0.4;
+  const std_msgs::String edited_text = asJson(edited);
+  const topology::TopologicalMap edited_map = topology::parseMap(edited_text.data, "/topological_map_2");
+  ASSERT_EQ(edited_map.numNodes(), lcas_map.numNodes() - 2);
+  ASSERT_TRUE(edited_map.index(renamed).has_value());
+  map_pub.publish(edited_text);
+  const ros::WallTime adopted_by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
+  bool adopted = false;
+  while (ros::ok() && ros::WallTime::now() < adopted_by && !adopted) {
+    fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
+    ros::WallDuration(0.5).sleep();
+    std::lock_guard<std::mutex> lock(m);
+    adopted = current == renamed;
+  }
+  {
+    std::lock_guard<std::mutex> lock(m);
+    EXPECT_EQ(current, renamed) << "current_node still names a node the map no longer has";
+  }
+  {
+    std::lock_guard<std::mutex> lock(belief_mutex);
+    double near = 0.0;  // mass within 3 m of the picker, on nodes of the new map
+    for (std::size_t k = 0; k < belief.nodes.size() && k < belief.masses.size(); ++k) {
+      const auto n = edited_map.index(belief.nodes[k]);
+      ASSERT_TRUE(n.has_value()) << belief.nodes[k] << " is not a node of the edited map";
+      if ((edited_map.position2d(*n) - p_map).norm() < 3.0) near += belief.masses[k];
+    }
+    EXPECT_GT(near, 0.5) << "the belief lost the picker with the map edit";
+  }
+
+  // A map with a non-numeric coordinate, then one with an edge to a missing node: each refused with a
+  // diagnostics ERROR by both nodes, the edited map kept.
+  for (const char* broken : {"coordinate", "edge"}) {
+    YAML::Node bad = YAML::Clone(edited);
+    if (std::string(broken) == "coordinate")
+      bad["nodes"][5]["node"]["pose"]["position"]["x"] = "twelve";
+    else
+      bad["nodes"][5]["node"]["edges"][0]["node"] = "NoSuchWayPoint";
+    {
+      std::lock_guard<std::mutex> lock(diag_mutex);
+      map_errors.clear();
+    }
+    map_pub.publish(asJson(bad));
+    const ros::WallTime by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
+    while (ros::ok() && ros::WallTime::now() < by) {
+      {
+        std::lock_guard<std::mutex> lock(diag_mutex);
+        if (map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker")) break;
+      }
+      ros::WallDuration(0.1).sleep();
+    }
+    std::lock_guard<std::mutex> lock(diag_mutex);
+    EXPECT_TRUE(map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker"))
+        << "a map with a bad " << broken << " was not refused by both nodes";
+  }
+  ros::WallDuration(1.0).sleep();
+  ASSERT_TRUE(ros::master::getNodes(nodes));
+  for (const char* node : {"/gnss_ingest", "/tpf_tracker"})
+    EXPECT_NE(std::find(nodes.begin(), nodes.end(), node), nodes.end()) << node << " died on a map edit";
   std::lock_guard<std::mutex> lock(m);
-  EXPECT_EQ(current, expected) << "the picker stands at " << expected << " (" << p_map.transpose()
-                               << " in the map frame)";
+  EXPECT_EQ(current, renamed) << "a refused map moved the picker";
 }
 
 int main(int argc, char** argv) {

@@ -4,7 +4,11 @@
 #include <picker_localisation/GetTopologicalMap.h>
 #include <picker_localisation/TopologicalMap.h>
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
 
 namespace {
 template <class M>
@@ -63,6 +67,56 @@ TEST(MapServer, Diagnostics) {
       }
   }
   EXPECT_TRUE(found);
+}
+
+// A map manager edited the file: ~reload publishes the new map (one node fewer) with what changed; a file
+// that cannot be read is refused with the reason and the current map stays on the topic.
+TEST(MapServer, ReloadPublishesTheEditedFileAndRefusesABrokenOne) {
+  ros::NodeHandle nh;
+  std::string original;
+  ASSERT_TRUE(nh.getParam("/topological_map_server/map_file", original));
+  YAML::Node doc = YAML::LoadFile(original);
+  const std::string gone = doc["nodes"][doc["nodes"].size() - 1]["node"]["name"].as<std::string>();
+  YAML::Node kept(YAML::NodeType::Sequence);
+  for (std::size_t i = 0; i + 1 < doc["nodes"].size(); ++i) {
+    YAML::Node n = doc["nodes"][i];
+    YAML::Node edges(YAML::NodeType::Sequence);
+    for (const YAML::Node& e : n["node"]["edges"])
+      if (e["node"].as<std::string>() != gone) edges.push_back(e);
+    n["node"]["edges"] = edges;
+    kept.push_back(n);
+  }
+  doc["nodes"] = kept;
+  const std::string edited = testing::TempDir() + "/map_server_edited.tmap2";
+  {
+    std::ofstream out(edited);
+    out << doc;
+  }
+  std::size_t latest_nodes = 0;
+  ros::Subscriber sub = nh.subscribe<picker_localisation::TopologicalMap>(
+      "/picker_localisation/topological_map", 2,
+      [&](const picker_localisation::TopologicalMap::ConstPtr& m) { latest_nodes = m->nodes.size(); });
+  ASSERT_TRUE(ros::service::waitForService("/topological_map_server/reload", ros::Duration(30.0)));
+  nh.setParam("/topological_map_server/map_file", edited);
+  std_srvs::Trigger reload;
+  ASSERT_TRUE(ros::service::call("/topological_map_server/reload", reload));
+  EXPECT_TRUE(reload.response.success) << reload.response.message;
+  EXPECT_NE(reload.response.message.find("+0 -1 nodes"), std::string::npos) << reload.response.message;
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(30.0);
+  while (latest_nodes != 137u && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    ros::WallDuration(0.05).sleep();
+  }
+  EXPECT_EQ(latest_nodes, 137u);
+  nh.setParam("/topological_map_server/map_file", edited + ".missing");
+  std_srvs::Trigger broken;
+  ASSERT_TRUE(ros::service::call("/topological_map_server/reload", broken));
+  EXPECT_FALSE(broken.response.success);
+  EXPECT_NE(broken.response.message.find("current map stays"), std::string::npos) << broken.response.message;
+  auto still = waitLatched<picker_localisation::TopologicalMap>("/picker_localisation/topological_map");
+  ASSERT_TRUE(still);
+  EXPECT_EQ(still->nodes.size(), 137u);
+  nh.setParam("/topological_map_server/map_file", original);
 }
 
 int main(int argc, char** argv) {

@@ -1,6 +1,7 @@
 // Topology core: both loaders on the real Riseholme maps, malformed inputs, every query.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -353,4 +354,43 @@ TEST(Tmap2Loader, TransformationAndDatum) {
   EXPECT_NE(errorOf(nodes + "meta: {datum_latitude: 53.2}\n").find("meta.datum_longitude"), std::string::npos);
   EXPECT_NE(errorOf(nodes + "meta: {datum_latitude: 95, datum_longitude: 0}\n").find("out of range"),
             std::string::npos);
+}
+
+// A map edited at run time: nodes renamed, removed and moved are counted, and every old node has a place on
+// the new map (its own name, else the nearest node to where it was).
+TEST(MapChange, RenamedRemovedMovedAndIdentical) {
+  const TopologicalMap before = makePolytunnelMap(PolytunnelSpec());
+  EXPECT_TRUE(compareMaps(before, before).identical());
+  std::vector<Node> nodes = before.nodes();
+  std::vector<EdgeSpec> edges;
+  for (const Edge& e : before.edges())
+    edges.push_back({e.id, before.node(e.source).name, before.node(e.target).name, e.action});
+  const std::string renamed_from = nodes[3].name, removed = nodes[7].name, moved = nodes[10].name;
+  auto rename = [&](std::string& n) {
+    if (n == renamed_from) n = "renamed";
+  };
+  for (Node& n : nodes) rename(n.name);
+  for (EdgeSpec& e : edges) {
+    rename(e.source);
+    rename(e.target);
+  }
+  nodes.erase(nodes.begin() + 7);
+  edges.erase(std::remove_if(edges.begin(), edges.end(),
+                             [&](const EdgeSpec& e) { return e.source == removed || e.target == removed; }),
+              edges.end());
+  for (Node& n : nodes)
+    if (n.name == moved) n.position.x() += 0.5;
+  const TopologicalMap after = TopologicalMap::build("edited", nodes, edges);
+  const MapChange c = compareMaps(before, after);
+  EXPECT_EQ(c.added, 1u);    // "renamed"
+  EXPECT_EQ(c.removed, 2u);  // the old name and the removed node
+  EXPECT_EQ(c.moved, 1u);
+  EXPECT_TRUE(c.edges_changed);
+  EXPECT_FALSE(c.datum_changed);
+  EXPECT_EQ(c.summary(), "+1 -2 nodes, 1 moved, edges changed");
+  ASSERT_EQ(c.old_to_new.size(), before.numNodes());
+  EXPECT_EQ(after.node(c.old_to_new[3]).name, "renamed");  // same place, new name
+  EXPECT_EQ(c.old_to_new[7], after.nearestNode(before.position2d(7)));
+  EXPECT_EQ(after.node(c.old_to_new[10]).name, moved);  // a moved node keeps its name
+  EXPECT_EQ(after.node(c.old_to_new[0]).name, before.node(0).name);
 }

@@ -1142,3 +1142,41 @@ TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {
   EXPECT_GT(laneShare(true), 0.9);
   EXPECT_LT(laneShare(false), 0.5);
 }
+
+// A map edited at run time: the particles move onto the new map (removed node: the nearest), velocities and
+// bias states kept, the belief names only nodes of the new map.
+TEST(TpfMapUpdate, ParticlesFollowTheEditedMap) {
+  auto before = polytunnel();
+  TopologicalParticleFilter f(before, TpfParams(), 7);
+  const NodeIndex at = before->laneNodes(1)[2];
+  ASSERT_TRUE(f.update(obsAt(1.0, {at}, {1.0})).ok());
+  std::vector<topology::Node> nodes = before->nodes();
+  std::vector<topology::EdgeSpec> edges;
+  const std::string gone = before->node(at).name;
+  for (const auto& e : before->edges())
+    if (e.source != at && e.target != at)
+      edges.push_back({e.id, before->node(e.source).name, before->node(e.target).name, e.action});
+  nodes.erase(nodes.begin() + at);
+  auto after = std::make_shared<const topology::TopologicalMap>(
+      topology::TopologicalMap::build("edited", nodes, edges));
+  const topology::MapChange change = topology::compareMaps(*before, *after);
+  std::vector<float> vx;
+  for (const Particle& p : f.particles()) vx.push_back(p.vx);
+  f.adoptMap(after, change.old_to_new);
+  EXPECT_EQ(&f.map(), after.get());
+  ASSERT_EQ(f.particles().size(), vx.size());
+  for (std::size_t i = 0; i < vx.size(); ++i) {
+    EXPECT_LT(f.particles()[i].node, after->numNodes());
+    EXPECT_EQ(f.particles()[i].vx, vx[i]);
+  }
+  double mass = 0.0;
+  for (std::size_t k = 0; k < f.belief().nodes.size(); ++k) mass += f.belief().masses[k];
+  EXPECT_NEAR(mass, 1.0, 1e-9);
+  // The mass that sat on the removed node is at the node nearest to it.
+  EXPECT_EQ(f.belief().map_node, change.old_to_new[at]);
+  EXPECT_LT((after->position2d(f.belief().map_node) - before->position2d(at)).norm(), 3.0);
+  EXPECT_FALSE(after->index(gone).has_value());
+  // It goes on filtering on the new map.
+  EXPECT_TRUE(f.update(obsAt(2.0, {change.old_to_new[at]}, {1.0})).ok());
+  EXPECT_THROW(f.adoptMap(after, {}), std::invalid_argument);
+}

@@ -26,10 +26,10 @@ EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "ordering_latency", o.ordering_latency);
   core::readOption(y, c, "max_truth_distance", o.max_truth_distance);
   core::readOption(y, c, "max_future_stamp", o.max_future_stamp);
-  static const std::vector<std::string> known{
-        "pickers_file",       "sample_rate",      "duration", "output_csv",    "ordering_latency",
-        "max_truth_distance", "max_future_stamp", "map_file", "map_topic",     "belief_topic",
-        "registry_topic"};
+  static const std::vector<std::string> known{"pickers_file",     "sample_rate",      "duration",
+                                              "output_csv",       "ordering_latency", "max_truth_distance",
+                                              "max_future_stamp", "map_file",         "map_topic",
+                                              "belief_topic",     "registry_topic",   "registry_publisher"};
   return core::checkOptions(o, y, known, c, unknown);
 }
 
@@ -84,6 +84,17 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   diagnostics_.input("ground truth", 5.0);
   diagnostics_.input("beliefs");
   diagnostics_.start(nh);
+  // A map edited at run time: errors are measured on it from now on; the samples taken before name the node
+  // each of theirs maps to on the new map (the same name, else the nearest), so the CSV uses one map.
+  map_follower_ = std::make_unique<MapFollower>(
+      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& c) {
+        for (Picker& p : pickers_)
+          for (eval::ErrorSample& s : p.samples) {
+            s.estimated_node = c.old_to_new.at(s.estimated_node);
+            s.true_node = c.old_to_new.at(s.true_node);
+          }
+        map_ = std::move(m);
+      });
   sample_period_ = 1.0 / sample_rate;
   // The timer only polls; samples fall on the stamp grid (see the header).
   timer_ = nh.createTimer(ros::Duration(std::min(sample_period_, 0.1)), &Evaluator::onTimer, this);
@@ -168,7 +179,10 @@ void Evaluator::sampleAt(double t) {
     if (auto n = latestAtOrBefore(p.belief_history, t)) p.estimated_node = *n;
     if (auto x = latestAtOrBefore(p.truth_history, t)) p.truth = *x;
     if (!p.estimated_node || !p.truth) continue;
-    const eval::ErrorSample s = eval::computeError(*map_, *map_->index(*p.estimated_node), *p.truth, t, p.id);
+    const auto estimated = map_->index(*p.estimated_node);
+    if (!estimated)
+      continue;  // a belief on a node the map lost in an edit: the tracker's next one will not be
+    const eval::ErrorSample s = eval::computeError(*map_, *estimated, *p.truth, t, p.id);
     p.samples.push_back(s);
     picker_localisation::TrackingError msg;
     msg.header.stamp = ros::Time(t);

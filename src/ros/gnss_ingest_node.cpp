@@ -22,7 +22,8 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  std::string datum_file, datum_source;
+  std::string& datum_file = datum_file_;
+  std::string& datum_source = datum_source_;
   pnh.param<std::string>("datum_file", datum_file, "");
   pnh.param<std::string>("datum_source", datum_source, "auto");
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
@@ -112,7 +113,41 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   diagnostics_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   for (const char* input : {"fixes", "people", "identifying observations", "beliefs"}) diagnostics_.input(input);
   diagnostics_.start(nh);
+  map_follower_ = std::make_unique<MapFollower>(
+      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& c) {
+        adoptMap(std::move(m), c);
+      });
   ok_ = true;
+}
+
+void GnssIngestNode::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
+                              const topology::MapChange& change) {
+  // The map's own datum moved (LCAS add_datum again): fixes are placed in the new frame from now on.
+  bool datum_moved = false;
+  if (change.datum_changed) {
+    try {
+      if (useMapDatum(datum_source_, *map)) {
+        datum_ = std::make_unique<core::GeodeticDatum>(map->datum()->config());
+        datum_moved = true;
+      } else if (datum_source_ != "file" && !datum_file_.empty()) {  // the map's datum is gone: the file's
+        datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file_));
+        datum_moved = true;
+      }
+    } catch (const std::exception& e) {
+      ROS_ERROR("gnss_ingest: the new map's datum is not used, keeping the current one: %s", e.what());
+    }
+  }
+  map_ = std::move(map);
+  for (auto& p : pickers_) {
+    p->ingest.setMap(map_, *datum_, datum_moved);
+    p->beliefs.clear();  // node indices of the old map; the tracker's next beliefs refill them
+  }
+  identity_.clear();
+  const std::size_t dropped = ordering_.size();
+  ordering_.clear();  // people decoded on the old map's nodes
+  if (dropped > 0)
+    ROS_WARN("gnss_ingest: %zu fix(es) / people waiting for stamp order dropped with the old map", dropped);
+  if (datum_moved) ROS_INFO("gnss_ingest: datum of the new map taken; fix histories restart in its frame");
 }
 
 bool GnssIngestNode::addPicker(const core::PickerConfig& p) {

@@ -74,6 +74,11 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     pnh_.param("map_timeout", map_timeout, map_timeout);
     map_ = obtainMap(nh_, pnh_, map_timeout);
     if (!map_) return;
+    // A map edited at run time: the next people are placed on it (nothing kept names a node).
+    map_follower_ =
+        std::make_unique<MapFollower>(nh_, pnh_, map_,
+                                      [this](std::shared_ptr<const topology::TopologicalMap> m,
+                                             const topology::MapChange&) { map_ = std::move(m); });
   }
 
   std::vector<std::string> scan_topics{"scan"};

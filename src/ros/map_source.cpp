@@ -45,7 +45,7 @@ std::string topicType(const std::string& topic) {
 // not exist yet (it needs the map), so the status goes out here.
 class MapRefusals {
  public:
-  MapRefusals(ros::NodeHandle& nh, std::string node, std::string topic)
+  MapRefusals(const ros::NodeHandle& nh, std::string node, std::string topic)
       : nh_(nh), node_(std::move(node)), topic_(std::move(topic)) {}
 
   // True when `fingerprint` is the message refused last (a latched topic delivers it again until replaced).
@@ -53,23 +53,26 @@ class MapRefusals {
     return fingerprint_ && fingerprint == *fingerprint_;
   }
 
-  void refuse(const std::string& fingerprint, const std::string& why) {
+  void refuse(const std::string& fingerprint, const std::string& why,
+              const char* meanwhile = "waiting for a valid one") {
     fingerprint_ = fingerprint;
     last_error_ = why;
-    ROS_ERROR("%s: map message on %s refused, waiting for a valid one: %s", node_.c_str(), topic_.c_str(),
-              why.c_str());
+    ++count_;
+    ROS_ERROR("%s: map message on %s refused, %s: %s", node_.c_str(), topic_.c_str(), meanwhile, why.c_str());
     report(diagnostic_msgs::DiagnosticStatus::ERROR, "map message on " + topic_ + " refused: " + why);
   }
 
   // After a refusal, the valid map taken clears the ERROR (OK, same status name).
   void taken(const topology::TopologicalMap& map) {
     if (!fingerprint_) return;
+    fingerprint_.reset();
     ROS_INFO("%s: valid map '%s' on %s taken after the refused one", node_.c_str(), map.name().c_str(),
              topic_.c_str());
     report(diagnostic_msgs::DiagnosticStatus::OK, "map '" + map.name() + "' taken from " + topic_);
   }
 
   const std::string& lastError() const { return last_error_; }
+  std::size_t count() const { return count_; }
 
  private:
   void report(std::uint8_t level, const std::string& message) {
@@ -88,10 +91,12 @@ class MapRefusals {
     diag_pub->publish(array);
   }
 
-  ros::NodeHandle& nh_;
+  ros::NodeHandle nh_;
   std::string node_, topic_;
-  std::optional<std::string> fingerprint_;  // of the message refused last; none before any refusal
+  std::optional<std::string>
+      fingerprint_;  // of the message refused last; none before any or after a valid one
   std::string last_error_;
+  std::size_t count_ = 0;
 };
 
 // What tells two map messages apart cheaply enough (the text itself; the header and size of a map message).
@@ -174,6 +179,79 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
     ROS_FATAL("%s: %s", name.c_str(), e.what());
   }
   return nullptr;
+}
+
+struct MapFollower::Impl {
+  Impl(ros::NodeHandle& nh, std::string node, std::string topic)
+      : refusals(nh, node, topic), node(std::move(node)), topic(std::move(topic)) {}
+
+  // One map message: nothing when it is the current one (or the one refused last), else refused or adopted.
+  template <typename M, typename Convert>
+  void onMessage(const M& msg, Convert convert) {
+    std::string fingerprint = fingerprintOf(msg);
+    if (fingerprint == current_fingerprint || refusals.alreadyRefused(fingerprint)) return;
+    std::shared_ptr<const topology::TopologicalMap> map;
+    try {
+      map = convert(msg);
+    } catch (const std::exception& e) {  // topology::MapError, or anything else a conversion meets
+      refusals.refuse(fingerprint, e.what(), "keeping the current map");
+      return;
+    }
+    refusals.taken(*map);
+    current_fingerprint = std::move(fingerprint);
+    const topology::MapChange change = topology::compareMaps(*current, *map);
+    if (change.identical()) return;  // re-published unchanged (the latched message seen at subscription)
+    ROS_INFO("%s: map updated: %s (map '%s' on %s, %zu nodes)", node.c_str(), change.summary().c_str(),
+             map->name().c_str(), topic.c_str(), map->numNodes());
+    current = map;
+    ++updates;
+    adopt(map, change);
+  }
+
+  MapRefusals refusals;
+  std::string node, topic, current_fingerprint;
+  std::shared_ptr<const topology::TopologicalMap> current;
+  Adopt adopt;
+  ros::Subscriber sub;
+  std::size_t updates = 0;
+};
+
+MapFollower::MapFollower(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+                         std::shared_ptr<const topology::TopologicalMap> current, Adopt adopt) {
+  std::string map_file;
+  if (!pnh.getParam("map_file", map_file)) nh.getParam("/map_file", map_file);
+  if (!map_file.empty() || !current) return;
+  const std::string topic = mapTopic(nh, pnh);
+  impl_ = std::make_unique<Impl>(nh, ros::this_node::getName(), topic);
+  impl_->current = std::move(current);
+  impl_->adopt = std::move(adopt);
+  Impl* impl = impl_.get();
+  const std::string type = topicType(topic);
+  if (type == "std_msgs/String") {
+    impl_->sub = nh.subscribe<std_msgs::String>(topic, 1, [impl, topic](const std_msgs::String::ConstPtr& m) {
+      impl->onMessage(*m, [&](const std_msgs::String& text) {
+        return std::make_shared<topology::TopologicalMap>(topology::parseMap(text.data, topic));
+      });
+    });
+  } else {  // the type obtainMap() read (topological_map_server's), also while nobody publishes
+    impl_->sub = nh.subscribe<picker_localisation::TopologicalMap>(
+        topic, 1, [impl](const picker_localisation::TopologicalMap::ConstPtr& m) {
+          impl->onMessage(*m, [](const picker_localisation::TopologicalMap& msg) {
+            return std::make_shared<topology::TopologicalMap>(fromMsg(msg));
+          });
+        });
+  }
+}
+
+MapFollower::~MapFollower() = default;
+bool MapFollower::following() const {
+  return impl_ != nullptr;
+}
+std::size_t MapFollower::updates() const {
+  return impl_ ? impl_->updates : 0;
+}
+std::size_t MapFollower::refusals() const {
+  return impl_ ? impl_->refusals.count() : 0;
 }
 
 }  // namespace ros_adapter

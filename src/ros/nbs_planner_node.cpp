@@ -92,6 +92,20 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     ROS_FATAL("%s: %s", name.c_str(), e.what());
     return;
   }
+  // A map edited at run time: the planner is built again on it (same configuration); the last plan, which
+  // names nodes of the old map, is forgotten. Beliefs and goals are kept by node name.
+  map_follower_ = std::make_unique<MapFollower>(
+      nh_, pnh_, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+        try {
+          auto rebuilt = std::make_unique<nbs::NextBestSensePlanner>(m, planner_->config());
+          planner_ = std::move(rebuilt);
+          map_ = std::move(m);
+          last_plan_.reset();
+        } catch (const std::exception& e) {
+          ROS_ERROR("%s: the new map is not used, planning on the current one: %s",
+                    ros::this_node::getName().c_str(), e.what());
+        }
+      });
 
   // Inputs: the trackers' beliefs (never ground truth), the other robots' goals, the battery.
   beliefs_ = std::make_unique<FleetBeliefs>(
@@ -286,7 +300,9 @@ void NbsPlannerNode::planOnce() {
   std::vector<nbs::Claim> goals;
   for (const auto& [id, g] : peer_goals_) {
     if ((stamp - g.received).toSec() > claim_timeout_ || g.msg.node.empty()) continue;  // stale
-    goals.push_back({id, *map_->index(g.msg.node), g.msg.target_picker});
+    const auto node = map_->index(g.msg.node);
+    if (!node) continue;  // a node the map lost in an edit since the goal came
+    goals.push_back({id, *node, g.msg.target_picker});
   }
   nbs::PlanResult plan = planner_->plan(*robot, battery_level_, pointers, nbs::claimsFor(robot_id_, goals));
   bool fallback = false;

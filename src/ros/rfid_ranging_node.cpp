@@ -43,6 +43,11 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     model_->setRegistry(r);
     ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());
   });
+  map_follower_ = std::make_unique<MapFollower>(
+      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+        map_ = m;
+        model_->setMap(std::move(m));
+      });
   ok_ = true;
 }
 

@@ -11,10 +11,11 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string map_file, frame_id;
-  double node_scale = 0.35;
-  bool labels = true;
+TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle& pnh) : pnh_(pnh) {
+  std::string map_file;
+  std::string& frame_id = frame_id_;
+  double& node_scale = node_scale_;
+  bool& labels = labels_;
   if (!pnh.getParam("map_file", map_file) || map_file.empty()) {
     ROS_FATAL("topological_map_server: parameter ~map_file is required (a tmap2 or legacy tmap file)");
     return;
@@ -32,18 +33,14 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
   }
   try {
     const topology::TopologicalMap map = topology::loadMap(map_file);
-    msg_ = toMsg(map, frame_id);
-    msg_.header.stamp = ros::Time::now();
     // Not /topological_map: LCAS topological_navigation publishes its own type there.
     map_pub_ = nh.advertise<picker_localisation::TopologicalMap>(kMapTopic, 1, /*latch=*/true);
     marker_pub_ = nh.advertise<visualization_msgs::MarkerArray>("topological_map/markers", 1, /*latch=*/true);
     service_ = nh.advertiseService("get_topological_map", &TopologicalMapServer::serveMap, this);
-    map_pub_.publish(msg_);
-    marker_pub_.publish(mapMarkers(map, frame_id, node_scale, labels));
-    ROS_INFO("topological_map_server: '%s' from %s: %zu nodes, %zu directed edges, %zu lanes", map.name().c_str(),
-             map_file.c_str(), map.numNodes(), map.numDirectedEdges(), map.numLanes());
-    lanes_ = map.numLanes();
-    components_ = map.numComponents();
+    reload_service_ = pnh.advertiseService("reload", &TopologicalMapServer::reload, this);
+    publish(map);
+    ROS_INFO("topological_map_server: '%s' from %s: %zu nodes, %zu directed edges, %zu lanes",
+             map.name().c_str(), map_file.c_str(), map.numNodes(), map.numDirectedEdges(), map.numLanes());
     diagnostics_.setHardwareID(map_file);
     diagnostics_.add("topological map", this, &TopologicalMapServer::diagnose);
     diagnostics_.start(nh, 1.0, /*wall=*/true);
@@ -51,6 +48,37 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
   } catch (const topology::MapError& e) {
     ROS_FATAL("topological_map_server: %s", e.what());
   }
+}
+
+void TopologicalMapServer::publish(const topology::TopologicalMap& map) {
+  msg_ = toMsg(map, frame_id_);
+  msg_.header.stamp = ros::Time::now();
+  msg_.header.seq = static_cast<std::uint32_t>(reloads_);  // a new message to the followers' fingerprint
+  map_pub_.publish(msg_);
+  marker_pub_.publish(mapMarkers(map, frame_id_, node_scale_, labels_));
+  lanes_ = map.numLanes();
+  components_ = map.numComponents();
+  map_ = std::make_shared<topology::TopologicalMap>(map);
+}
+
+bool TopologicalMapServer::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::string map_file;
+  pnh_.getParam("map_file", map_file);
+  try {
+    const topology::TopologicalMap map = topology::loadMap(map_file);
+    const topology::MapChange change = topology::compareMaps(*map_, map);
+    ++reloads_;
+    publish(map);
+    res.success = true;
+    res.message = "map '" + map.name() + "' from " + map_file + " published: " + change.summary();
+    ROS_INFO("topological_map_server: %s", res.message.c_str());
+  } catch (const std::exception& e) {
+    ++reloads_refused_;
+    res.success = false;
+    res.message = std::string("not reloaded, the current map stays: ") + e.what();
+    ROS_ERROR("topological_map_server: %s", res.message.c_str());
+  }
+  return true;
 }
 
 void TopologicalMapServer::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
@@ -66,6 +94,7 @@ void TopologicalMapServer::diagnose(diagnostic_updater::DiagnosticStatusWrapper&
   stat.add("lanes", lanes_);
   stat.add("components", components_);
   stat.add("service requests", requests_);
+  stat.add("reloads / refused", std::to_string(reloads_) + " / " + std::to_string(reloads_refused_));
 }
 
 bool TopologicalMapServer::serveMap(GetTopologicalMap::Request&, GetTopologicalMap::Response& res) {

@@ -305,6 +305,10 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   diagnostics_.add("tpf_tracker", this, &TpfTracker::diagnoseFleet);
   diagnostics_.input("observations");
   diagnostics_.start(nh);
+  map_follower_ =
+      std::make_unique<MapFollower>(nh_, pnh, map_,
+                                    [this](std::shared_ptr<const topology::TopologicalMap> m,
+                                           const topology::MapChange& c) { adoptMap(std::move(m), c); });
   ROS_INFO("tpf_tracker: %zu picker(s), map '%s' (%zu nodes), ordering latency %.2f s (%s)", tracks_.size(),
            map_->name().c_str(), map_->numNodes(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "fused on arrival");
@@ -519,6 +523,27 @@ void TpfTracker::checkClockJump() {
     publish(*kv.second);
   }
   flush();
+}
+
+void TpfTracker::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
+                          const topology::MapChange& change) {
+  flush();  // the queued messages name nodes of the old map
+  const std::size_t dropped = ordering_.size();
+  ordering_.clear();  // decoded on the old map's node indices
+  map_ = std::move(map);
+  for (auto& kv : tracks_) {
+    Track& t = *kv.second;
+    try {
+      t.filter->adoptMap(map_, change.old_to_new);
+    } catch (const std::exception& e) {
+      caught(t, e);
+    }
+    publish(t);  // current_node is sent when its name changed (renamed, removed)
+  }
+  flush();
+  ++map_updates_;
+  if (dropped > 0)
+    ROS_WARN("tpf_tracker: %zu observation(s) waiting for stamp order dropped with the old map", dropped);
 }
 
 void TpfTracker::orderingTick(const ros::TimerEvent&) {
@@ -740,6 +765,9 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("observations received", received_);
   stat.add("observations for no tracked picker", unrouted_);
   stat.add("observations with more nodes than the map (dropped)", oversized_);
+  stat.add(
+      "map updates adopted / map messages refused",
+      std::to_string(map_updates_) + " / " + std::to_string(map_follower_ ? map_follower_->refusals() : 0));
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("clock jumps back (beliefs reset)", stamp_guard_.jumps());
   stat.add("ordering latency (s)", ordering_latency_);

@@ -51,6 +51,11 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     uwb_->setRegistry(r);
     ROS_INFO("uwb_ranging: picker list from the tracker: %zu picker(s)", r.size());
   });
+  map_follower_ = std::make_unique<MapFollower>(
+      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+        map_ = m;
+        uwb_->setMap(std::move(m));
+      });
   ok_ = true;
 }
 

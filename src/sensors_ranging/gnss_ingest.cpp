@@ -38,14 +38,40 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
   count("jump_reset_count", o.jump_reset_count);
   o.bias = GnssBiasOptions::fromYaml(y);
   o.association = PickerAssociationOptions::fromYaml(y);
-  std::vector<std::string> known = {
-        "default_sigma",    "min_sigma",    "cutoff_sigmas",     "max_nodes",
-        "velocity_window",  "max_speed",    "jump_gate_sigmas",  "jump_reset_count",
-        "blackout_timeout", "max_map_distance", "pickers_file", "datum_file",        "datum_source",      "map_file",
-        "map_timeout",      "frame_id",     "observation_topic", "map_topic", "max_future_stamp", "silent_warn_after",
-        "people_pose_topics", "people_pose_sensor", "people_pose_sigma", "pose_topic_format", "pose_sensor",
-        "person_observation_topic", "belief_topic", "bias_topic_prefix", "ordering_latency", "registry_topic",
-        "on_demand_topics_above", "demand_poll_period"};
+  std::vector<std::string> known = {"default_sigma",
+                                    "min_sigma",
+                                    "cutoff_sigmas",
+                                    "max_nodes",
+                                    "velocity_window",
+                                    "max_speed",
+                                    "jump_gate_sigmas",
+                                    "jump_reset_count",
+                                    "blackout_timeout",
+                                    "max_map_distance",
+                                    "pickers_file",
+                                    "datum_file",
+                                    "datum_source",
+                                    "map_file",
+                                    "map_timeout",
+                                    "frame_id",
+                                    "observation_topic",
+                                    "map_topic",
+                                    "max_future_stamp",
+                                    "silent_warn_after",
+                                    "people_pose_topics",
+                                    "people_pose_sensor",
+                                    "people_pose_sigma",
+                                    "pose_topic_format",
+                                    "pose_sensor",
+                                    "person_observation_topic",
+                                    "belief_topic",
+                                    "bias_topic_prefix",
+                                    "ordering_latency",
+                                    "registry_topic",
+                                    "registry_publisher",
+                                    "max_people_per_message",
+                                    "on_demand_topics_above",
+                                    "demand_poll_period"};
   known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
   known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(), PickerAssociationOptions::yamlKeys().end());
   return core::checkOptions(o, y, known, c, unknown);
@@ -336,6 +362,18 @@ GnssIngest::Prediction GnssIngest::predictPosition(double t, double speed, doubl
   pr.mean = last_->position - bias_.applied(t);
   pr.covariance = bias_.appliedCovariance(t) + (r * r + m * m) * Eigen::Matrix2d::Identity();
   return pr;
+}
+
+void GnssIngest::setMap(std::shared_ptr<const topology::TopologicalMap> map, const core::GeodeticDatum& datum,
+                        bool datum_moved) {
+  if (!map) return;
+  map_ = std::move(map);
+  if (!datum_moved) return;
+  datum_ = datum;
+  window_.clear();
+  recent_.clear();
+  last_.reset();
+  consecutive_jumps_ = 0;
 }
 
 }  // namespace sensors

@@ -473,5 +473,42 @@ std::string TopologicalMap::laneNameOf(NodeIndex i) const {
   return l == kNoLane ? std::string() : laneName(l);
 }
 
+std::string MapChange::summary() const {
+  std::ostringstream s;
+  s << "+" << added << " -" << removed << " nodes, " << moved << " moved";
+  if (edges_changed) s << ", edges changed";
+  if (datum_changed) s << ", datum changed";
+  return s.str();
+}
+
+MapChange compareMaps(const TopologicalMap& before, const TopologicalMap& after) {
+  MapChange c;
+  c.old_to_new.resize(before.numNodes(), kInvalidNode);
+  for (NodeIndex i = 0; i < before.numNodes(); ++i) {
+    const Node& old_node = before.node(i);
+    if (const auto same = after.index(old_node.name)) {
+      c.old_to_new[i] = *same;
+      if ((after.node(*same).position - old_node.position).norm() > 0.01) ++c.moved;
+    } else {
+      ++c.removed;
+      c.old_to_new[i] = after.nearestNode(before.position2d(i));
+    }
+  }
+  for (const Node& n : after.nodes())
+    if (!before.index(n.name)) ++c.added;
+  auto named = [](const TopologicalMap& m) {
+    std::set<std::pair<std::string, std::string>> pairs;
+    for (const Edge& e : m.edges()) pairs.emplace(m.node(e.source).name, m.node(e.target).name);
+    return pairs;
+  };
+  c.edges_changed = named(before) != named(after);
+  const auto& da = before.datum();
+  const auto& db = after.datum();
+  c.datum_changed = da.has_value() != db.has_value() ||
+                    (da && (da->latitude != db->latitude || da->longitude != db->longitude ||
+                            da->altitude != db->altitude));
+  return c;
+}
+
 }  // namespace topology
 }  // namespace picker_localisation

@@ -278,6 +278,34 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   reset();
 }
 
+void TopologicalParticleFilter::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
+                                         const std::vector<topology::NodeIndex>& old_to_new) {
+  if (!map || map->numNodes() == 0) throw std::invalid_argument("adoptMap: empty map");
+  if (old_to_new.size() != map_->numNodes())
+    throw std::invalid_argument("adoptMap: the mapping has " + std::to_string(old_to_new.size()) +
+                                " entries for " + std::to_string(map_->numNodes()) + " nodes");
+  for (topology::NodeIndex n : old_to_new)
+    if (n >= map->numNodes()) throw std::invalid_argument("adoptMap: the mapping names a node the map lacks");
+  map_ = std::move(map);
+  graph_ = std::make_shared<const MotionGraph>(
+      *map_, params_.directed_motion,
+      params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
+      params_.lane_change_max_hops);
+  bias_fix_variance_ = params_.gnss_bias_fix_std * params_.gnss_bias_fix_std +
+                       graph_->median_arc_length * graph_->median_arc_length / 12.0;
+  edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
+  projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
+  node_scratch_a_.assign(map_->numNodes(), 0.0);
+  node_scratch_b_.assign(map_->numNodes(), 0.0);
+  touched_.clear();
+  for (Particle& p : particles_) {
+    p.node = old_to_new[p.node];
+    p.lane_change = 0;
+    p.last_lane_change = 0;
+  }
+  if (!particles_.empty()) recordBelief(false);  // the support and n* on the new map's nodes
+}
+
 void TopologicalParticleFilter::reset() {
   particles_.clear();
   resampled_.clear();

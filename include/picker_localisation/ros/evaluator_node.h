@@ -17,9 +17,10 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 
-#include "picker_localisation/ros/fleet_topics.h"
-#include "picker_localisation/ros/stamp_guard.h"
 #include <ros/ros.h>
+#include "picker_localisation/ros/fleet_topics.h"
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/stamp_guard.h"
 
 #include <deque>
 #include <map>
@@ -80,6 +81,7 @@ class Evaluator {
 
   bool ok_ = false, done_ = false, finished_ = false;
   std::shared_ptr<const topology::TopologicalMap> map_;
+  std::unique_ptr<MapFollower> map_follower_;
   std::vector<Picker> pickers_;
   std::map<std::string, std::size_t> index_;  // picker id -> pickers_ index
   std::unique_ptr<FleetBeliefs> beliefs_;     // ~belief_topic: the fleet stream, or "" per picker

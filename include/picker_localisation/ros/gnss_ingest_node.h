@@ -66,6 +66,8 @@ class GnssIngestNode {
   void useIdentified(const core::Observation& obs);
   void onBelief(const picker_localisation::PickerBelief& msg);
   bool checkClock();
+  // A new map from the map topic (MapFollower): every picker's ingest, and the datum when the map's moved.
+  void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
   std::vector<sensors::GnssIngest*> pickerPointers();
   std::vector<const sensors::BeliefHistory*> beliefHistories() const;
   void releaseOrdered();
@@ -78,6 +80,8 @@ class GnssIngestNode {
   ros::NodeHandle nh_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::unique_ptr<core::GeodeticDatum> datum_;
+  std::string datum_file_, datum_source_;  // ~datum_file, ~datum_source (a new map's datum follows them)
+  std::unique_ptr<MapFollower> map_follower_;
   std::string frame_id_, bias_prefix_;
   sensors::GnssIngestOptions options_;
   sensors::IdentityEvidence identity_;  // RFID reads / failed reads per picker (association_identity_sensors)

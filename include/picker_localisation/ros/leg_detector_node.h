@@ -3,7 +3,6 @@
 // person on /observations. Fusion with a camera when ~detections_topic is set (Antonucci 2022 Algorithm 4).
 #pragma once
 
-#include "picker_localisation/ros/node_diagnostics.h"
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <picker_localisation/BearingDetectionArray.h>
 #include <ros/ros.h>
@@ -12,6 +11,8 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/node_diagnostics.h"
 
 #include <map>
 #include <memory>
@@ -59,6 +60,7 @@ class LegDetectorNode {
   std::unique_ptr<vision::LegPipeline> pipeline_;
   vision::Cloud3dPersonDetector cloud_detector_;
   std::shared_ptr<const topology::TopologicalMap> map_;
+  std::unique_ptr<MapFollower> map_follower_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   std::vector<ros::Subscriber> subs_;

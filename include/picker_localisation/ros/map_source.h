@@ -9,6 +9,7 @@
 
 #include <ros/ros.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -33,6 +34,31 @@ bool useMapDatum(const std::string& datum_source, const topology::TopologicalMap
 
 // The map topic obtainMap() reads (~map_topic, /map_topic or kMapTopic), resolved.
 std::string mapTopic(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+
+// The map after start-up: a map manager may edit it while the robot runs (LCAS topological_navigation
+// re-publishes /topological_map_2; topological_map_server's ~reload). Every node that read its map from the
+// topic keeps following it with one MapFollower: a later valid map that differs from the current one is
+// handed to `adopt` with how it differs (topology::compareMaps), after one INFO line "<node>: map updated:
+// +N -M nodes, K moved"; a message that cannot be read is refused with one ERROR line and diagnostics ERROR
+// ("<node>: map"), the current map kept; an identical re-publication (the latched message again) costs one
+// comparison. A node given ~map_file (or /map_file) has nothing to follow and never calls `adopt`.
+class MapFollower {
+ public:
+  using Adopt = std::function<void(std::shared_ptr<const topology::TopologicalMap> map,
+                                   const topology::MapChange& change)>;
+  MapFollower(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+              std::shared_ptr<const topology::TopologicalMap> current, Adopt adopt);
+  ~MapFollower();
+  MapFollower(const MapFollower&) = delete;
+  MapFollower& operator=(const MapFollower&) = delete;
+  bool following() const;
+  std::size_t updates() const;   // maps adopted
+  std::size_t refusals() const;  // messages refused
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace ros_adapter
 }  // namespace picker_localisation

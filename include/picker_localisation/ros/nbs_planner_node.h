@@ -31,9 +31,10 @@
 #include <string>
 #include <vector>
 
-#include "picker_localisation/ros/fleet_topics.h"
-#include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
+#include "picker_localisation/ros/fleet_topics.h"
+#include "picker_localisation/ros/map_source.h"
+#include "picker_localisation/ros/stamp_guard.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
@@ -80,6 +81,7 @@ class NbsPlannerNode {
   ros::NodeHandle nh_, pnh_;
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::unique_ptr<nbs::NextBestSensePlanner> planner_;
+  std::unique_ptr<MapFollower> map_follower_;
   std::string robot_id_, map_frame_, base_frame_;
   double battery_level_ = 1.0;
   double claim_timeout_ = 30.0;

@@ -32,6 +32,7 @@
 #include "picker_localisation/core/stamp_ordered_buffer.h"
 #include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/last_value_publisher.h"
+#include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/picker_association.h"

@@ -6,19 +6,19 @@
 // ~remove_picker (RemovePicker) and ~list_pickers (ListPickers). A bad request (invalid, empty or duplicate
 // id, an empty tag or one another picker wears, a bad GNSS topic name, bad overrides) is refused with a
 // message and changes nothing. Started from a pickers file, the current list is latched on <prefix>/registry
-// (PickerList), which gnss_ingest, rfid_ranging and uwb_ranging follow (not with one ~picker_id, which names no GNSS topic).
-// Per picker: <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
+// (PickerList), which gnss_ingest, rfid_ranging and uwb_ranging follow (not with one ~picker_id, which names
+// no GNSS topic). Per picker: <prefix>/<id>/belief (PickerBelief), <prefix>/<id>/estimate
 // (geometry_msgs/PoseWithCovarianceStamped, the MAP node's pose; covariance = mass-weighted spread of the
 // belief's nodes), <prefix>/<id>/markers (MarkerArray: belief support coloured by mass, MAP node highlighted;
-// built only while someone subscribes), <ns>/<id>/current_node (std_msgs/String, the MAP node's name, on change:
-// what LCAS coordination reads of an agent; ns ~current_node_namespace, default the prefix, "/" for
+// built only while someone subscribes), <ns>/<id>/current_node (std_msgs/String, the MAP node's name, on
+// change: what LCAS coordination reads of an agent; ns ~current_node_namespace, default the prefix, "/" for
 // /<id>/current_node, "" none); services <prefix>/<id>/reset (ResetBelief) and <prefix>/<id>/what_if
 // (WhatIf, on a copy of the filter); prefix ~topic_prefix = /pickers. Each topic behaves as latched (a new
 // subscriber gets the current message at once) but costs nothing while nobody listens (LastValuePublisher).
-// Every picker's beliefs also stream on <prefix>/beliefs (PickerBeliefArray, not latched): one connection for a
-// consumer of the whole fleet (gnss_ingest), and under load one message per burst of beliefs.
-// Routing: one subscription to ~observations_topic (/observations); each message is decoded once and goes to
-// the one filter it identifies, to its candidate pickers, or (anonymous, no candidates) to every filter
+// Every picker's beliefs also stream on <prefix>/beliefs (PickerBeliefArray, not latched): one connection for
+// a consumer of the whole fleet (gnss_ingest), and under load one message per burst of beliefs. Routing: one
+// subscription to ~observations_topic (/observations); each message is decoded once and goes to the one
+// filter it identifies, to its candidate pickers, or (anonymous, no candidates) to every filter
 // (core::concernsPicker's rule, by lookup).
 // Time: periodic prediction at each picker's prediction_rate (ROS time, one timer for all pickers) when no
 // observation arrived for a period, on lastStamp + k / prediction_rate (never on the time a timer fired).
@@ -27,12 +27,14 @@
 // 0.5 s under /use_sim_time (bags, simulator: deterministic replay), 0 live (each observation fused on
 // arrival, within milliseconds; one that arrives late, within reorder_window, is fused at the filter's
 // current time, as the filter documents). Clock jumps back reset every belief.
-// Above ~on_demand_topics_above pickers (default 100) the per-picker topics are advertised only while some node
-// subscribes to them (the master is polled every ~demand_poll_period, 2 s; a new subscriber gets the current
-// message on connect): roscpp's per-message cost grows with the publications of a process, and a farm's
-// thousands of unwatched topics made that cost larger than the filters'. Subscribe to any of them (rviz,
-// rostopic echo) and it appears within the poll period. The fleet stream is always advertised.
+// Above ~on_demand_topics_above pickers (default 100) the per-picker topics are advertised only while some
+// node subscribes to them (the master is polled every ~demand_poll_period, 2 s; a new subscriber gets the
+// current message on connect): roscpp's per-message cost grows with the publications of a process, and a
+// farm's thousands of unwatched topics made that cost larger than the filters'. Subscribe to any of them
+// (rviz, rostopic echo) and it appears within the poll period. The fleet stream is always advertised.
 // Diagnostics: one status for the fleet and one per picker.
+// Map: ~map_file, else the latched map topic, followed for the node's life: an edited map is adopted by every
+// filter (adoptMap), a malformed one refused (MapFollower).
 // Parameters (private): pickers_file or picker_id, map_file (else the latched topological_map topic),
 // tpf_params_file (YAML like config/tpf.yaml) overridden key by key by private parameters with the same
 // names (e.g. ~num_particles, ~method) and then by a picker's own overrides, seed (0: derived from each
@@ -65,6 +67,7 @@
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
 #include "picker_localisation/ros/last_value_publisher.h"
+#include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
 
@@ -146,6 +149,10 @@ class TpfTracker {
   // The clock jumped back (bag loop, simulator restart): every belief and the waiting observations are dropped
   // so the next observation initialises each filter again (its stamps would all be "too old" otherwise).
   void checkClockJump();
+  // A new map from the map topic (MapFollower): every filter moves onto it (particles on removed or renamed
+  // nodes to the nearest node of the new map, velocities and bias states kept) and republishes at once, so
+  // current_node names a node of the new map.
+  void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
 
   bool ok_ = false;
   ros::NodeHandle nh_;
@@ -169,6 +176,8 @@ class TpfTracker {
   NodeDiagnostics diagnostics_;
   std::uint64_t received_ = 0, unrouted_ = 0, added_ = 0, removed_ = 0, refused_requests_ = 0, oversized_ = 0;
   StampGuard stamp_guard_;
+  std::unique_ptr<MapFollower> map_follower_;
+  std::uint64_t map_updates_ = 0;
 };
 
 }  // namespace ros_adapter

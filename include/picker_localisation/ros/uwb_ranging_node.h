@@ -26,6 +26,7 @@ class UwbRangingNode {
 
   bool ok_ = false;
   std::shared_ptr<const topology::TopologicalMap> map_;
+  std::unique_ptr<MapFollower> map_follower_;  // a map edited at run time (map topic)
   std::string map_frame_, base_frame_;
   double tf_timeout_ = 0.2;
   std::unique_ptr<sensors::UwbRanging> uwb_;

@@ -156,6 +156,12 @@ class GnssIngest {
   // Seconds since the last accepted fix (+inf before the first).
   double ageOfLastFix(double now) const;
 
+  // The map edited at run time: fixes are placed on `map` from now on. A changed datum (`datum_moved`) moves
+  // the map frame, so the fix history (positions in the old frame) is forgotten, as after a blackout; the
+  // bias estimate, a vector east-north, holds in both frames and is kept.
+  void setMap(std::shared_ptr<const topology::TopologicalMap> map, const core::GeodeticDatum& datum,
+              bool datum_moved);
+
   const GnssCounters& counters() const { return counters_; }
   const std::string& pickerId() const { return picker_id_; }
   const core::GeodeticDatum& datum() const { return datum_; }

@@ -112,6 +112,10 @@ class RfidObservationModel {
   // The pickers changed at run time (tpf_tracker's list): reads of a tag go to its wearer now, negative
   // information to every picker now tracked.
   void setRegistry(core::PickerRegistry registry) { registry_ = std::move(registry); }
+  // The map edited at run time: read regions are found on `map` from the next read (no state names a node).
+  void setMap(std::shared_ptr<const topology::TopologicalMap> map) {
+    if (map) map_ = std::move(map);
+  }
   // Map nodes inside the read region of an antenna at pose (x, y, yaw), sorted: within regionRadius() (and the
   // beam).
   std::vector<topology::NodeIndex> nodesInReadRegion(const Eigen::Vector3d& antenna_pose) const;

@@ -112,6 +112,11 @@ class UwbRanging {
   // The pickers changed at run time (tpf_tracker's list): a tag no longer worn by the same picker loses its
   // filter (it would carry the old wearer's position).
   void setRegistry(core::PickerRegistry registry);
+  // The map edited at run time: observations are built on `map` from the next one (the tags' filters are
+  // metric, in the map frame, and are kept).
+  void setMap(std::shared_ptr<const topology::TopologicalMap> map) {
+    if (map) map_ = std::move(map);
+  }
   const RangeHistogramFilter* filter(const std::string& tag_id) const;  // nullptr before the tag's first update
   const UwbRangingOptions& options() const { return options_; }
 

@@ -134,6 +134,13 @@ class TopologicalParticleFilter {
   bool predictTo(double stamp);
   // Forget everything: the next observation initialises the filter again (Eq. 1).
   void reset();
+  // The map was edited at run time: the filter moves to `map`, each particle to old_to_new[its node]
+  // (topology::compareMaps: the node of the same name, else the one nearest to where it was). Velocities,
+  // dwell times and GNSS bias states are kept; lane-change paths and side memory, which index the old graph's
+  // paths, are forgotten (the next lane end starts them again). Throws std::invalid_argument on an empty map
+  // or a mapping that is not one new node per old node.
+  void adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
+                const std::vector<topology::NodeIndex>& old_to_new);
 
   const Belief& belief() const { return belief_; }
   const FilterCounters& counters() const { return counters_; }
