@@ -359,6 +359,16 @@ TEST(NbsPlannerNode, FollowsThePickerListOfTheTracker) {
   ASSERT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "0"; }))
       << "robot_1 never listed picker_9";
   EXPECT_EQ(value("robot_1", "beliefs received picker_3"), "") << "picker_3 left the list";
+  // A new picker's first belief, "waiting for the first observation" (no nodes), is nothing to reject.
+  {
+    std::lock_guard<std::mutex> lock(g_mutex);
+    picker_localisation::PickerBelief waiting;
+    waiting.header.stamp = ros::Time::now();
+    waiting.picker_id = "picker_9";
+    g_fleet.beliefs.push_back(waiting);
+    g_fleet_pub.publish(g_fleet);
+    g_fleet.beliefs.pop_back();
+  }
   {
     std::lock_guard<std::mutex> lock(g_mutex);
     g_fleet.beliefs.push_back(beliefMsg("picker_9", {g_confident_node}, {1.0}, g_confident_node));
@@ -366,6 +376,7 @@ TEST(NbsPlannerNode, FollowsThePickerListOfTheTracker) {
   }
   EXPECT_TRUE(waitFor([&] { return value("robot_1", "beliefs received picker_9") == "1"; }))
       << "robot_1 counted " << value("robot_1", "beliefs received picker_9") << " beliefs of picker_9";
+  EXPECT_EQ(value("robot_1", "beliefs rejected picker_9"), "0") << "the empty first belief was called bad";
 }
 
 int main(int argc, char** argv) {
