@@ -23,6 +23,7 @@
 #include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/ros/ranging_nodes.h"
 #include "picker_localisation/topology/map_io.h"
+#include "tmap_edits.h"
 #include "wait_deadline.h"
 
 using namespace picker_localisation;
@@ -68,30 +69,6 @@ void writeJson(const YAML::Node& n, std::ostream& out) {
 
 constexpr double kDatumLatitude = 52.1, kDatumLongitude = 1.2;  // not config/datum.yaml's
 
-// A map manager's edit of a tmap2 document: node `from` renamed `to` (its entry and every edge into it).
-void renameNode(YAML::Node& doc, const std::string& from, const std::string& to) {
-  for (YAML::Node n : doc["nodes"]) {
-    if (n["node"]["name"].as<std::string>() == from) {
-      n["node"]["name"] = to;
-      n["meta"]["node"] = to;
-    }
-    for (YAML::Node e : n["node"]["edges"])
-      if (e["node"].as<std::string>() == from) e["node"] = to;
-  }
-}
-// Node `name` removed with every edge into it.
-void removeNode(YAML::Node& doc, const std::string& name) {
-  YAML::Node kept(YAML::NodeType::Sequence);
-  for (YAML::Node n : doc["nodes"]) {
-    if (n["node"]["name"].as<std::string>() == name) continue;
-    YAML::Node edges(YAML::NodeType::Sequence);
-    for (const YAML::Node& e : n["node"]["edges"])
-      if (e["node"].as<std::string>() != name) edges.push_back(e);
-    n["node"]["edges"] = edges;
-    kept.push_back(n);
-  }
-  doc["nodes"] = kept;
-}
 std_msgs::String asJson(const YAML::Node& doc) {
   std::ostringstream json;
   writeJson(doc, json);
@@ -147,15 +124,20 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   ros::Publisher map_pub = nh.advertise<std_msgs::String>("/topological_map_2", 1, /*latch=*/true);
   std_msgs::String truncated;
   truncated.data = text.data.substr(0, text.data.size() / 3);
-  map_pub.publish(truncated);
-  const ros::WallTime refused_by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
-  while (ros::ok() && ros::WallTime::now() < refused_by) {
-    {
-      std::lock_guard<std::mutex> lock(diag_mutex);
-      if (map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker")) break;
+  // True once both nodes reported a map ERROR (or at the deadline, false).
+  auto bothRefused = [&] {
+    const ros::WallTime by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
+    while (ros::ok() && ros::WallTime::now() < by) {
+      {
+        std::lock_guard<std::mutex> lock(diag_mutex);
+        if (map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker")) return true;
+      }
+      ros::WallDuration(0.1).sleep();
     }
-    ros::WallDuration(0.1).sleep();
-  }
+    return false;
+  };
+  map_pub.publish(truncated);
+  bothRefused();
   {
     std::lock_guard<std::mutex> lock(diag_mutex);
     ASSERT_TRUE(map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker"))
@@ -184,14 +166,17 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   c.longitude = kDatumLongitude;
   const core::GeodeticDatum datum(c);
   const std::string expected = lcas_map.node(target).name;
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
-  bool reached = false;
-  while (ros::ok() && ros::WallTime::now() < end && !reached) {
-    fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
-    ros::WallDuration(0.5).sleep();
-    std::lock_guard<std::mutex> lock(m);
-    reached = current == expected;
-  }
+  // Fixes where the picker stands, every 0.5 s, until current_node names `node` (or the deadline).
+  auto fixesUntilCurrentNodeIs = [&](const std::string& node) {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
+      ros::WallDuration(0.5).sleep();
+      std::lock_guard<std::mutex> lock(m);
+      if (current == node) return;
+    }
+  };
+  fixesUntilCurrentNodeIs(expected);
   {
     std::lock_guard<std::mutex> lock(m);
     ASSERT_EQ(current, expected) << "the picker stands at " << expected << " (" << p_map.transpose()
@@ -210,9 +195,9 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
       });
   YAML::Node edited = YAML::Clone(doc);
   const std::string renamed = expected + "_renamed";
-  renameNode(edited, expected, renamed);
+  tmap_edits::renameNode(edited, expected, renamed);
   const auto& far_lane = lcas_map.laneNodes(0);
-  for (std::size_t k = 0; k < 2; ++k) removeNode(edited, lcas_map.node(far_lane[k]).name);
+  for (std::size_t k = 0; k < 2; ++k) tmap_edits::removeNode(edited, lcas_map.node(far_lane[k]).name);
   const auto& moved_lane = lcas_map.laneNodes(1);
   for (YAML::Node n : edited["nodes"])
     for (topology::NodeIndex i : moved_lane)
@@ -223,14 +208,7 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
   ASSERT_EQ(edited_map.numNodes(), lcas_map.numNodes() - 2);
   ASSERT_TRUE(edited_map.index(renamed).has_value());
   map_pub.publish(edited_text);
-  const ros::WallTime adopted_by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
-  bool adopted = false;
-  while (ros::ok() && ros::WallTime::now() < adopted_by && !adopted) {
-    fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
-    ros::WallDuration(0.5).sleep();
-    std::lock_guard<std::mutex> lock(m);
-    adopted = current == renamed;
-  }
+  fixesUntilCurrentNodeIs(renamed);
   {
     std::lock_guard<std::mutex> lock(m);
     EXPECT_EQ(current, renamed) << "current_node still names a node the map no longer has";
@@ -259,17 +237,7 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
       map_errors.clear();
     }
     map_pub.publish(asJson(bad));
-    const ros::WallTime by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
-    while (ros::ok() && ros::WallTime::now() < by) {
-      {
-        std::lock_guard<std::mutex> lock(diag_mutex);
-        if (map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker")) break;
-      }
-      ros::WallDuration(0.1).sleep();
-    }
-    std::lock_guard<std::mutex> lock(diag_mutex);
-    EXPECT_TRUE(map_errors.count("gnss_ingest") && map_errors.count("tpf_tracker"))
-        << "a map with a bad " << broken << " was not refused by both nodes";
+    EXPECT_TRUE(bothRefused()) << "a map with a bad " << broken << " was not refused by both nodes";
   }
   ros::WallDuration(1.0).sleep();
   ASSERT_TRUE(ros::master::getNodes(nodes));

@@ -10,6 +10,8 @@
 
 #include <fstream>
 
+#include "tmap_edits.h"
+
 namespace {
 template <class M>
 boost::shared_ptr<const M> waitLatched(const std::string& topic) {
@@ -76,17 +78,7 @@ TEST(MapServer, ReloadPublishesTheEditedFileAndRefusesABrokenOne) {
   std::string original;
   ASSERT_TRUE(nh.getParam("/topological_map_server/map_file", original));
   YAML::Node doc = YAML::LoadFile(original);
-  const std::string gone = doc["nodes"][doc["nodes"].size() - 1]["node"]["name"].as<std::string>();
-  YAML::Node kept(YAML::NodeType::Sequence);
-  for (std::size_t i = 0; i + 1 < doc["nodes"].size(); ++i) {
-    YAML::Node n = doc["nodes"][i];
-    YAML::Node edges(YAML::NodeType::Sequence);
-    for (const YAML::Node& e : n["node"]["edges"])
-      if (e["node"].as<std::string>() != gone) edges.push_back(e);
-    n["node"]["edges"] = edges;
-    kept.push_back(n);
-  }
-  doc["nodes"] = kept;
+  tmap_edits::removeNode(doc, doc["nodes"][doc["nodes"].size() - 1]["node"]["name"].as<std::string>());
   const std::string edited = testing::TempDir() + "/map_server_edited.tmap2";
   {
     std::ofstream out(edited);

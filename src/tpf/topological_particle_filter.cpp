@@ -263,6 +263,11 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   if (!map_ || map_->numNodes() == 0) throw std::invalid_argument("TopologicalParticleFilter: empty map");
   const std::string problem = params_.validate();
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
+  buildGraph();
+  reset();
+}
+
+void TopologicalParticleFilter::buildGraph() {
   graph_ = std::make_shared<const MotionGraph>(
       *map_, params_.directed_motion,
       params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
@@ -275,7 +280,7 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
   node_scratch_a_.assign(map_->numNodes(), 0.0);
   node_scratch_b_.assign(map_->numNodes(), 0.0);
-  reset();
+  touched_.clear();
 }
 
 void TopologicalParticleFilter::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
@@ -287,17 +292,7 @@ void TopologicalParticleFilter::adoptMap(std::shared_ptr<const topology::Topolog
   for (topology::NodeIndex n : old_to_new)
     if (n >= map->numNodes()) throw std::invalid_argument("adoptMap: the mapping names a node the map lacks");
   map_ = std::move(map);
-  graph_ = std::make_shared<const MotionGraph>(
-      *map_, params_.directed_motion,
-      params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
-      params_.lane_change_max_hops);
-  bias_fix_variance_ = params_.gnss_bias_fix_std * params_.gnss_bias_fix_std +
-                       graph_->median_arc_length * graph_->median_arc_length / 12.0;
-  edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
-  projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
-  node_scratch_a_.assign(map_->numNodes(), 0.0);
-  node_scratch_b_.assign(map_->numNodes(), 0.0);
-  touched_.clear();
+  buildGraph();
   for (Particle& p : particles_) {
     p.node = old_to_new[p.node];
     p.lane_change = 0;

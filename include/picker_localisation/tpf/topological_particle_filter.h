@@ -183,6 +183,8 @@ class TopologicalParticleFilter {
  private:
   struct MotionGraph;  // CSR adjacency with unit edge directions and lengths, shared by copies
 
+  // The motion graph, the bias fix variance and the scratch buffers of map_ (constructor, adoptMap).
+  void buildGraph();
   UpdateResult reject(UpdateStatus status, std::string reason);
   void initialise(const core::Observation& obs);
   void reinitialisePart(const core::Observation& obs, double fraction);
