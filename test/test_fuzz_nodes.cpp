@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <picker_localisation/AddPicker.h>
 #include <picker_localisation/ListPickers.h>
 #include <picker_localisation/PickerBeliefArray.h>
@@ -92,6 +93,7 @@ TEST(FuzzNodes, MapMutantsAndRandomServiceRequests) {
     }
   };
   std::size_t calls = 0, answered = 0, mutants = 0;
+  std::vector<std::string> added;  // pickers the fuzzing added (removed again at the end)
   for (int i = 0; i < 60; ++i) {
     if (i % 2 == 0) {
       std_msgs::String mutant;
@@ -107,11 +109,12 @@ TEST(FuzzNodes, MapMutantsAndRandomServiceRequests) {
         a.request.picker.gnss_topic = topics[w.index(topics.size())];
         a.request.tpf_overrides = overrides();
         answered += ros::service::call("/tpf_tracker/add_picker", a);
+        if (a.response.success) added.push_back(a.request.picker.id);
         break;
       }
       case 1: {
         pl::RemovePicker r;
-        r.request.id = w.name(removable);
+        r.request.id = w.chance(0.5) && !added.empty() ? added[w.index(added.size())] : w.name(removable);
         answered += ros::service::call("/tpf_tracker/remove_picker", r);
         break;
       }
@@ -144,11 +147,22 @@ TEST(FuzzNodes, MapMutantsAndRandomServiceRequests) {
 
   // The valid map again: the nodes adopt it and go on tracking.
   map_pub.publish(original);
-  for (const std::string& id : {"picker_7", "picker_8", "p"}) {
+  for (const std::string& id : added) {
     pl::RemovePicker r;
     r.request.id = id;
     ros::service::call("/tpf_tracker/remove_picker", r);
   }
+  // The mutants reached the tracker: some refused (most are not maps), and it reports them.
+  std::string map_counts;  // "adopted / refused"
+  ros::Subscriber diag = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+        for (const auto& st : a->status)
+          for (const auto& kv : st.values)
+            if (kv.key == "map updates adopted / map messages refused") map_counts = kv.value;
+      });
+  EXPECT_TRUE(ranging_test::waitFor([&] {
+    return !map_counts.empty() && std::stoul(map_counts.substr(map_counts.find('/') + 1)) > 0;
+  })) << "tpf_tracker reports no refused map (" << map_counts << ")";
   std::vector<std::string> nodes;
   ASSERT_TRUE(ros::master::getNodes(nodes));
   for (const char* n : {"/tpf_tracker", "/gnss_ingest"})

@@ -14,6 +14,7 @@
 #include <picker_localisation/ListPickers.h>
 #include <picker_localisation/Observation.h>
 #include <picker_localisation/PickerBeliefArray.h>
+#include <picker_localisation/PickerList.h>
 #include <picker_localisation/RemovePicker.h>
 #include <picker_localisation/WhatIf.h>
 #include <rosgraph_msgs/Log.h>
@@ -61,10 +62,13 @@ class HostileInputs : public ::testing::Test {
     rosout_sub_ = nh_.subscribe<rosgraph_msgs::Log>(
         "/rosout", 1000, [this](const rosgraph_msgs::Log::ConstPtr& m) { log_.push_back(*m); });
     ASSERT_TRUE(ros::service::waitForService("/tpf_tracker/add_picker", ros::Duration(60.0)));
+    // Our own subscriptions count on our own publishers: the nodes' links are the second ones.
     ASSERT_TRUE(waitFor([&] {
       return fix_pubs_["picker_1"].getNumSubscribers() > 0 && fix_pubs_["picker_2"].getNumSubscribers() > 0 &&
              pose_pub_.getNumSubscribers() > 0 && people_pub_.getNumSubscribers() > 0 &&
-             fleet_sub_.getNumPublishers() > 0 && obs_sub_.getNumPublishers() > 0;
+             person_pub_.getNumSubscribers() > 0 && fleet_pub_.getNumSubscribers() >= 2 &&
+             obs_pub_.getNumSubscribers() >= 2 && fleet_sub_.getNumPublishers() >= 2 &&
+             rosout_sub_.getNumPublishers() >= 2;
     }));
   }
 
@@ -143,9 +147,12 @@ class HostileInputs : public ::testing::Test {
 TEST_F(HostileInputs, EveryNodeStaysUpAndBeliefsKeepComing) {
   ASSERT_TRUE(beliefsKeepComing()) << "no beliefs from fixes at the start";
 
-  // Another node's empty picker list: ignored, named in one line; GNSS keeps flowing.
-  EXPECT_TRUE(logged("/gnss_ingest", "picker list from /stranger ignored"));
-  EXPECT_TRUE(beliefsKeepComing()) << "the stranger's empty list stopped GNSS";
+  // Other nodes' empty picker lists (the stranger's, latched since the start, and this node's): ignored, each
+  // publisher named in one line; GNSS keeps flowing.
+  ros::Publisher list_pub = nh_.advertise<pl::PickerList>("/pickers/registry", 1, /*latch=*/true);
+  list_pub.publish(pl::PickerList());
+  EXPECT_TRUE(logged("/gnss_ingest", "picker list from /hostile_inputs ignored"));
+  EXPECT_TRUE(beliefsKeepComing()) << "a stranger's empty list stopped GNSS";
 
   // add_picker requests no farm can afford or that would half-add a picker: refused, nothing changes.
   auto keys = [](int n) {  // an overrides mapping of n made-up keys
@@ -166,7 +173,7 @@ TEST_F(HostileInputs, EveryNodeStaysUpAndBeliefsKeepComing) {
       {addRequest("picker_7", "", keys(1000)), "keys"},
       {addRequest("picker_7", "", "{a: '" + std::string(100000, 'x') + "'}"), "characters"},
       {addRequest("picker_7", "~fix", ""), "private"},
-      {addRequest("picker_7", "/pickers/picker_1/fix", ""), "picker_1"},
+      {addRequest("picker_7", "/pickers/picker_1/fix", ""), "belongs to both"},
       {addRequest("p" + std::string(10000, 'x'), "", ""), "longer than"}};
   for (auto& b : bad) {
     ASSERT_TRUE(ros::service::call("/tpf_tracker/add_picker", b.call)) << b.says;

@@ -213,6 +213,19 @@ TEST(LcasMap, CurrentNodeOnAJsonMapWithDatumAndTransformation) {
     std::lock_guard<std::mutex> lock(m);
     EXPECT_EQ(current, renamed) << "current_node still names a node the map no longer has";
   }
+  // The belief and current_node come on separate connections: wait for a belief on the new map's nodes.
+  const ros::WallTime belief_by = ros::WallTime::now() + ros::WallDuration(test_wait::kDeadline);
+  while (ros::ok() && ros::WallTime::now() < belief_by) {
+    {
+      std::lock_guard<std::mutex> lock(belief_mutex);
+      if (!belief.nodes.empty() && std::all_of(belief.nodes.begin(), belief.nodes.end(), [&](const std::string& n) {
+            return edited_map.index(n).has_value();
+          }))
+        break;
+    }
+    fix_pub.publish(ros_adapter::navSatFixAt(datum, p_map, ros::Time::now(), 0.3));
+    ros::WallDuration(0.5).sleep();
+  }
   {
     std::lock_guard<std::mutex> lock(belief_mutex);
     double near = 0.0;  // mass within 3 m of the picker, on nodes of the new map

@@ -74,7 +74,8 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
     return "position or its covariance is not finite";
   if (obs.position) {
     const Eigen::Matrix2d& c = obs.position_covariance;
-    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) + 1e-12)
+    // Relative tolerance: a rank-1 covariance of large variances is PSD up to rounding.
+    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) * (1.0 + 1e-9) + 1e-12)
       return "position covariance is not positive semi-definite";
   }
   if (obs.bias_removed) {

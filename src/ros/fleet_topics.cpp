@@ -33,16 +33,16 @@ ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, cons
   pnh.param<std::string>("registry_publisher", publisher, "/tpf_tracker");
   if (!publisher.empty()) publisher = ros::names::resolve(publisher);
   const std::string name = node;
+  // One warning per foreign publisher (at most 100 named): each stranger is named once, none floods the log.
+  auto warned = std::make_shared<std::set<std::string>>();
   return nh.subscribe<picker_localisation::PickerList>(
       topic, 2,
       boost::function<void(const ros::MessageEvent<picker_localisation::PickerList const>&)>(
-          [name, publisher, apply](const ros::MessageEvent<picker_localisation::PickerList const>& event) {
+          [name, publisher, apply, warned](const ros::MessageEvent<picker_localisation::PickerList const>& event) {
             if (!publisher.empty() && event.getPublisherName() != publisher) {
-              ROS_WARN_THROTTLE(10.0,
-                                "%s: picker list from %s ignored: only %s's lists are followed "
-                                "(~registry_publisher)",
-                                name.c_str(), core::clippedForLog(event.getPublisherName()).c_str(),
-                                publisher.c_str());
+              if (warned->size() < 100 && warned->insert(event.getPublisherName()).second)
+                ROS_WARN("%s: picker list from %s ignored: only %s's lists are followed (~registry_publisher)",
+                         name.c_str(), core::clippedForLog(event.getPublisherName()).c_str(), publisher.c_str());
               return;
             }
             const picker_localisation::PickerList& msg = *event.getConstMessage();

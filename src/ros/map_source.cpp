@@ -104,8 +104,25 @@ std::string fingerprintOf(const std_msgs::String& m) {
   return m.data;
 }
 std::string fingerprintOf(const picker_localisation::TopologicalMap& m) {
+  // The header and a hash (FNV-1a) of the content: a restarted server publishes seq 0 again, and under a
+  // simulated clock that has not started every stamp is 0.
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* data, std::size_t size) {
+    for (std::size_t i = 0; i < size; ++i) h = (h ^ static_cast<const unsigned char*>(data)[i]) * 1099511628211ull;
+  };
+  for (const auto& n : m.nodes) {
+    mix(n.name.data(), n.name.size());
+    mix(&n.pose.position.x, sizeof(double));
+    mix(&n.pose.position.y, sizeof(double));
+    mix(n.lane.data(), n.lane.size());
+  }
+  for (const auto& e : m.edges) {
+    mix(&e.source, sizeof(e.source));
+    mix(&e.target, sizeof(e.target));
+  }
+  mix(m.name.data(), m.name.size());
   return std::to_string(m.header.seq) + "/" + std::to_string(m.header.stamp.toNSec()) + "/" +
-         std::to_string(m.nodes.size());
+         std::to_string(m.nodes.size()) + "/" + std::to_string(h);
 }
 
 // One message of type M from `topic`, turned into a map by `convert`; nullptr when none came within a second,
@@ -189,7 +206,11 @@ struct MapFollower::Impl {
   template <typename M, typename Convert>
   void onMessage(const M& msg, Convert convert) {
     std::string fingerprint = fingerprintOf(msg);
-    if (fingerprint == current_fingerprint || refusals.alreadyRefused(fingerprint)) return;
+    if (fingerprint == current_fingerprint) {
+      refusals.taken(*current);  // the current map re-sent after a refused one: the ERROR is over
+      return;
+    }
+    if (refusals.alreadyRefused(fingerprint)) return;
     std::shared_ptr<const topology::TopologicalMap> map;
     try {
       map = convert(msg);
@@ -197,15 +218,20 @@ struct MapFollower::Impl {
       refusals.refuse(fingerprint, e.what(), "keeping the current map");
       return;
     }
-    refusals.taken(*map);
-    current_fingerprint = std::move(fingerprint);
-    const topology::MapChange change = topology::compareMaps(*current, *map);
-    if (change.identical()) return;  // re-published unchanged (the latched message seen at subscription)
-    ROS_INFO("%s: map updated: %s (map '%s' on %s, %zu nodes)", node.c_str(), change.summary().c_str(),
-             map->name().c_str(), topic.c_str(), map->numNodes());
-    current = map;
-    ++updates;
-    adopt(map, change);
+    try {
+      const topology::MapChange change = topology::compareMaps(*current, *map);
+      if (!change.identical()) {  // else re-published unchanged (the latched message seen at subscription)
+        ROS_INFO("%s: map updated: %s (map '%s' on %s, %zu nodes)", node.c_str(), change.summary().c_str(),
+                 map->name().c_str(), topic.c_str(), map->numNodes());
+        adopt(map, change);
+        current = map;
+        ++updates;
+      }
+      refusals.taken(*map);
+      current_fingerprint = std::move(fingerprint);
+    } catch (const std::exception& e) {  // nothing may end the node from a callback (std::bad_alloc)
+      ROS_ERROR("%s: map on %s not adopted: %s", node.c_str(), topic.c_str(), e.what());
+    }
   }
 
   MapRefusals refusals;

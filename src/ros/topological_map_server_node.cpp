@@ -55,7 +55,14 @@ void TopologicalMapServer::publish(const topology::TopologicalMap& map) {
   msg_.header.stamp = ros::Time::now();
   msg_.header.seq = static_cast<std::uint32_t>(reloads_);  // a new message to the followers' fingerprint
   map_pub_.publish(msg_);
-  marker_pub_.publish(mapMarkers(map, frame_id_, node_scale_, labels_));
+  visualization_msgs::MarkerArray markers = mapMarkers(map, frame_id_, node_scale_, labels_);
+  if (reloads_ > 0) {  // rviz keeps the labels of nodes the new map no longer has: clear them first
+    visualization_msgs::Marker clear;
+    clear.header.frame_id = frame_id_;
+    clear.action = visualization_msgs::Marker::DELETEALL;
+    markers.markers.insert(markers.markers.begin(), clear);
+  }
+  marker_pub_.publish(markers);
   lanes_ = map.numLanes();
   components_ = map.numComponents();
   map_ = std::make_shared<topology::TopologicalMap>(map);

@@ -536,7 +536,12 @@ void TpfTracker::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
     try {
       t.filter->adoptMap(map_, change.old_to_new);
     } catch (const std::exception& e) {
-      caught(t, e);
+      // The filter is still on the old map (adoptMap changes nothing when it throws): a fresh one on the new
+      // map, its belief forgotten, so every filter and this node share one map.
+      ROS_ERROR("tpf_tracker %s: belief not carried to the new map (%s); starting afresh", t.id.c_str(), e.what());
+      ++t.exceptions;
+      t.filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, t.filter->params(),
+                                                                  seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(t.id));
     }
     publish(t);  // current_node is sent when its name changed (renamed, removed)
   }

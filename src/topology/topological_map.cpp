@@ -477,6 +477,7 @@ std::string MapChange::summary() const {
   std::ostringstream s;
   s << "+" << added << " -" << removed << " nodes, " << moved << " moved";
   if (edges_changed) s << ", edges changed";
+  if (lanes_changed) s << ", lanes changed";
   if (datum_changed) s << ", datum changed";
   return s.str();
 }
@@ -489,6 +490,7 @@ MapChange compareMaps(const TopologicalMap& before, const TopologicalMap& after)
     if (const auto same = after.index(old_node.name)) {
       c.old_to_new[i] = *same;
       if ((after.node(*same).position - old_node.position).norm() > 0.01) ++c.moved;
+      if (before.laneNameOf(i) != after.laneNameOf(*same)) c.lanes_changed = true;
     } else {
       ++c.removed;
       c.old_to_new[i] = after.nearestNode(before.position2d(i));
@@ -502,6 +504,7 @@ MapChange compareMaps(const TopologicalMap& before, const TopologicalMap& after)
     return pairs;
   };
   c.edges_changed = named(before) != named(after);
+  if (before.laneNames() != after.laneNames()) c.lanes_changed = true;
   const auto& da = before.datum();
   const auto& db = after.datum();
   c.datum_changed = da.has_value() != db.has_value() ||

@@ -263,24 +263,28 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
   if (!map_ || map_->numNodes() == 0) throw std::invalid_argument("TopologicalParticleFilter: empty map");
   const std::string problem = params_.validate();
   if (!problem.empty()) throw std::invalid_argument("TopologicalParticleFilter: " + problem);
-  buildGraph();
+  useMap(map_);
   reset();
 }
 
-void TopologicalParticleFilter::buildGraph() {
-  graph_ = std::make_shared<const MotionGraph>(
-      *map_, params_.directed_motion,
-      params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
+void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::TopologicalMap> map) {
+  // What can throw (std::bad_alloc) first, into locals; then no-throw swaps: a failure leaves the filter as it was.
+  auto graph = std::make_shared<const MotionGraph>(
+      *map, params_.directed_motion, params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
       params_.lane_change_max_hops);
+  std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
+  std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0), node_b(map->numNodes(), 0.0);
+  map_.swap(map);
+  graph_.swap(graph);
+  edge_scratch_.swap(edge);
+  projection_scratch_.swap(projection);
+  node_scratch_a_.swap(node_a);
+  node_scratch_b_.swap(node_b);
+  touched_.clear();
   // GNSS bias state: a fix spreads about the particle's node by gnss_bias_fix_std plus where the picker is
   // between nodes (uniform over the node spacing: variance spacing^2 / 12), from the map, not tuned to one.
   bias_fix_variance_ = params_.gnss_bias_fix_std * params_.gnss_bias_fix_std +
                        graph_->median_arc_length * graph_->median_arc_length / 12.0;
-  edge_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
-  projection_scratch_.assign(std::max<std::size_t>(1, graph_->max_degree), 0.0);
-  node_scratch_a_.assign(map_->numNodes(), 0.0);
-  node_scratch_b_.assign(map_->numNodes(), 0.0);
-  touched_.clear();
 }
 
 void TopologicalParticleFilter::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
@@ -291,8 +295,7 @@ void TopologicalParticleFilter::adoptMap(std::shared_ptr<const topology::Topolog
                                 " entries for " + std::to_string(map_->numNodes()) + " nodes");
   for (topology::NodeIndex n : old_to_new)
     if (n >= map->numNodes()) throw std::invalid_argument("adoptMap: the mapping names a node the map lacks");
-  map_ = std::move(map);
-  buildGraph();
+  useMap(std::move(map));  // throws before changing anything
   for (Particle& p : particles_) {
     p.node = old_to_new[p.node];
     p.lane_change = 0;

@@ -205,11 +205,14 @@ struct MapChange {
   std::size_t moved = 0;               // same name, position changed by more than 1 cm
   bool edges_changed = false;          // the set of (source name, target name) pairs differs
   bool datum_changed = false;          // meta.datum_* added, removed or changed
+  bool lanes_changed = false;          // a kept node is in another lane (re-tagged) or the lane names differ
   // For every node of the old map, its node in the new one: the node of the same name, else the node nearest
   // to where it was (map frame), so what sat on a removed or renamed node lands where it was.
   std::vector<NodeIndex> old_to_new;
-  bool identical() const { return added + removed + moved == 0 && !edges_changed && !datum_changed; }
-  // "+N -M nodes, K moved" [", edges changed"] [", datum changed"].
+  bool identical() const {
+    return added + removed + moved == 0 && !edges_changed && !datum_changed && !lanes_changed;
+  }
+  // "+N -M nodes, K moved" [", edges changed"] [", lanes changed"] [", datum changed"].
   std::string summary() const;
 };
 MapChange compareMaps(const TopologicalMap& before, const TopologicalMap& after);

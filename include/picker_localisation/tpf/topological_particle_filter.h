@@ -183,8 +183,9 @@ class TopologicalParticleFilter {
  private:
   struct MotionGraph;  // CSR adjacency with unit edge directions and lengths, shared by copies
 
-  // The motion graph, the bias fix variance and the scratch buffers of map_ (constructor, adoptMap).
-  void buildGraph();
+  // Makes `map` the filter's map with its motion graph, bias fix variance and scratch buffers (constructor,
+  // adoptMap); on an exception (std::bad_alloc) nothing has changed.
+  void useMap(std::shared_ptr<const topology::TopologicalMap> map);
   UpdateResult reject(UpdateStatus status, std::string reason);
   void initialise(const core::Observation& obs);
   void reinitialisePart(const core::Observation& obs, double fraction);
