@@ -207,3 +207,22 @@ TEST(YamlFile, ParsesAndNamesTheFileInEveryError) {
   EXPECT_THROW(parseYamlFile(path + ".missing", [](const YAML::Node&) { return 0; }), std::runtime_error);
   std::remove(path.c_str());
 }
+
+// The one 2x2 covariance check: finite, symmetric, PSD up to a tolerance relative to the largest entry.
+TEST(Covariance2d, OneCheckForEveryNode) {
+  using picker_localisation::core::isCovariance2d;
+  EXPECT_TRUE(isCovariance2d(Eigen::Matrix2d::Identity()));
+  EXPECT_TRUE(isCovariance2d(Eigen::Matrix2d::Zero()));
+  Eigen::Matrix2d rank1;
+  rank1 << 1e4 / 3.0, 1e4 / 3.0 * std::sqrt(3.0), 1e4 / 3.0 * std::sqrt(3.0), 1e4;  // det 0 up to rounding
+  EXPECT_TRUE(isCovariance2d(rank1));
+  Eigen::Matrix2d c = Eigen::Matrix2d::Identity();
+  c(0, 0) = -4.0;
+  EXPECT_FALSE(isCovariance2d(c));  // a negative variance
+  c << 1.0, 2.0, 2.0, 1.0;
+  EXPECT_FALSE(isCovariance2d(c));  // determinant -3
+  c << 1.0, 0.5, 0.0, 1.0;
+  EXPECT_FALSE(isCovariance2d(c));  // not symmetric
+  c << 1.0, 0.0, 0.0, std::nan("");
+  EXPECT_FALSE(isCovariance2d(c));
+}

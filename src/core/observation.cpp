@@ -54,6 +54,12 @@ void setGaussianLikelihood(Observation& obs, const topology::TopologicalMap& map
   obs.position_covariance = c;
 }
 
+bool isCovariance2d(const Eigen::Matrix2d& c) {
+  if (!c.allFinite() || c(0, 0) < 0.0 || c(1, 1) < 0.0) return false;
+  const double scale = std::max(1.0, c.cwiseAbs().maxCoeff());
+  return std::abs(c(0, 1) - c(1, 0)) <= 1e-9 * scale && c.determinant() >= -1e-9 * scale * scale;
+}
+
 std::string validateObservation(const Observation& obs, const topology::TopologicalMap& map) {
   if (obs.nodes.size() != obs.likelihood.size()) return "nodes and likelihood differ in length";
   if (obs.nodes.empty()) return "empty likelihood";
@@ -72,17 +78,11 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   if (obs.velocity && !obs.velocity->allFinite()) return "velocity is not finite";
   if (obs.position && (!obs.position->allFinite() || !obs.position_covariance.allFinite()))
     return "position or its covariance is not finite";
-  if (obs.position) {
-    const Eigen::Matrix2d& c = obs.position_covariance;
-    // Relative tolerance: a rank-1 covariance of large variances is PSD up to rounding.
-    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) * (1.0 + 1e-9) + 1e-12)
-      return "position covariance is not positive semi-definite";
-  }
+  if (obs.position && !isCovariance2d(obs.position_covariance))
+    return "position covariance is not positive semi-definite";
   if (obs.bias_removed) {
-    const Eigen::Matrix2d& c = obs.bias_covariance;
-    if (!obs.bias_removed->allFinite() || !c.allFinite()) return "bias or its covariance is not finite";
-    if (c(0, 0) < 0.0 || c(1, 1) < 0.0 || c(0, 1) * c(1, 0) > c(0, 0) * c(1, 1) + 1e-12)
-      return "bias covariance is not positive semi-definite";
+    if (!obs.bias_removed->allFinite() || !obs.bias_covariance.allFinite()) return "bias or its covariance is not finite";
+    if (!isCovariance2d(obs.bias_covariance)) return "bias covariance is not positive semi-definite";
     if (!obs.position) return "bias without a position";
     if (!std::isfinite(obs.bias_drift_rate) || obs.bias_drift_rate < 0.0)
       return "bias drift rate is negative or not finite";

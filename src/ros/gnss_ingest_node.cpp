@@ -444,7 +444,7 @@ void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped
   cov << c[0], c[1], c[6], c[7];
   const Eigen::Vector2d at(msg->pose.pose.position.x, msg->pose.pose.position.y);
   cov = 0.5 * (cov + cov.transpose());
-  if (!at.allFinite() || !cov.allFinite() || cov(0, 0) < 0.0 || cov(1, 1) < 0.0 || cov.determinant() < -1e-9) {
+  if (!at.allFinite() || !core::isCovariance2d(cov)) {
     ++bad_poses_;
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: pose of %s dropped: position or covariance not finite / not PSD",
                       picker.c_str());

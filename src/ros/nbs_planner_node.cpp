@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/ros/map_conversions.h"
 #include "picker_localisation/ros/map_source.h"
@@ -205,10 +206,7 @@ void NbsPlannerNode::biasCallback(const std::string& picker_id,
   PickerInput& in = *found->second;
   const auto& c = msg->covariance;
   const Eigen::Matrix2d cov = (Eigen::Matrix2d() << c[0], c[1], c[2], c[3]).finished();
-  // A covariance: finite, symmetric, positive semi-definite (2x2: diagonal >= 0 and determinant >= 0).
-  const double tolerance = 1e-9 * (1.0 + cov.cwiseAbs().maxCoeff());
-  if (!cov.allFinite() || std::abs(cov(0, 1) - cov(1, 0)) > tolerance || cov(0, 0) < 0.0 || cov(1, 1) < 0.0 ||
-      cov.determinant() < -tolerance || (!msg->picker_id.empty() && msg->picker_id != picker_id)) {
+  if (!core::isCovariance2d(cov) || (!msg->picker_id.empty() && msg->picker_id != picker_id)) {
     ++in.bias_rejected;
     ROS_WARN_THROTTLE(10.0,
                       "%s: rejected a GNSS bias of %s (picker id '%s', covariance not a finite symmetric "

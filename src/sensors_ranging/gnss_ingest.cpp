@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/yaml_file.h"
 #include "picker_localisation/core/yaml_keys.h"
 
@@ -232,8 +233,7 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
     // DIAGONAL_KNOWN: off-diagonal terms are meaningless by definition.
     if (fix.covariance_type == 2) c_en(0, 1) = c_en(1, 0) = 0.0;
     c_en = 0.5 * (c_en + c_en.transpose());
-    const double tol = 1e-9 * std::max(1.0, c_en.trace());
-    if (c_en.determinant() < -tol)
+    if (!core::isCovariance2d(c_en))
       return reject(GnssRejection::kNegativeCovariance, "horizontal covariance is not positive semi-definite",
                     counters_.negative_covariance);
   }

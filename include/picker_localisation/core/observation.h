@@ -69,5 +69,10 @@ void setGaussianLikelihood(Observation& obs, const topology::TopologicalMap& map
 // positive. Returns an empty string when valid, else the reason.
 std::string validateObservation(const Observation& obs, const topology::TopologicalMap& map);
 
+// True when `c` is a 2x2 covariance: finite, symmetric and positive semi-definite, up to a tolerance relative to
+// its largest entry (a rank-1 covariance of large variances is PSD only up to rounding). The one check every
+// node applies to a covariance it receives.
+bool isCovariance2d(const Eigen::Matrix2d& c);
+
 }  // namespace core
 }  // namespace picker_localisation
