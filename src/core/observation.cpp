@@ -60,6 +60,15 @@ bool isCovariance2d(const Eigen::Matrix2d& c) {
   return std::abs(c(0, 1) - c(1, 0)) <= 1e-9 * scale && c.determinant() >= -1e-9 * scale * scale;
 }
 
+bool normaliseMasses(std::vector<double>& masses) {
+  const double peak = masses.empty() ? 0.0 : *std::max_element(masses.begin(), masses.end());
+  if (!(peak > 0.0) || !std::isfinite(peak)) return false;
+  double total = 0.0;
+  for (double& m : masses) total += (m /= peak);
+  for (double& m : masses) m /= total;
+  return true;
+}
+
 std::string validateObservation(const Observation& obs, const topology::TopologicalMap& map) {
   if (obs.nodes.size() != obs.likelihood.size()) return "nodes and likelihood differ in length";
   if (obs.nodes.empty()) return "empty likelihood";

@@ -22,10 +22,8 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  std::string& datum_file = datum_file_;
-  std::string& datum_source = datum_source_;
-  pnh.param<std::string>("datum_file", datum_file, "");
-  pnh.param<std::string>("datum_source", datum_source, "auto");
+  pnh.param<std::string>("datum_file", datum_file_, "");
+  pnh.param<std::string>("datum_source", datum_source_, "auto");
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
   sensors::GnssIngestOptions o;
   if (!loadOptions(pnh, o)) return;
@@ -38,16 +36,16 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   // The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
   // when the map has none.
   try {
-    if (useMapDatum(datum_source, *map_)) {
+    if (useMapDatum(datum_source_, *map_)) {
       const core::DatumConfig c = map_->datum()->config();
       datum_ = std::make_unique<core::GeodeticDatum>(c);
       ROS_INFO("gnss_ingest: datum from the map (%.7f, %.7f, %.1f m; ~datum_source file uses %s instead)",
-               c.latitude, c.longitude, c.altitude, datum_file.empty() ? "~datum_file" : datum_file.c_str());
+               c.latitude, c.longitude, c.altitude, datum_file_.empty() ? "~datum_file" : datum_file_.c_str());
     } else {
-      if (datum_file.empty())
+      if (datum_file_.empty())
         throw std::runtime_error("parameter ~datum_file (config/datum.yaml) is required: the map has no datum");
-      datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file));
-      ROS_INFO("gnss_ingest: datum from %s%s", datum_file.c_str(),
+      datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file_));
+      ROS_INFO("gnss_ingest: datum from %s%s", datum_file_.c_str(),
                map_->datum() ? " (~datum_source file: the map's own datum is not used)" : "");
     }
   } catch (const std::exception& e) {
@@ -338,25 +336,18 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
   }
   std::vector<topology::NodeIndex> nodes;
   std::vector<double> masses;
-  double peak = 0.0;
   for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k) {
     const auto n = map_->index(msg.nodes[k]);
     if (!n || !std::isfinite(msg.masses[k]) || msg.masses[k] < 0.0) continue;
     nodes.push_back(*n);
     masses.push_back(msg.masses[k]);
-    peak = std::max(peak, msg.masses[k]);
   }
-  if (!(peak > 0.0)) {
+  if (!core::normaliseMasses(masses)) {
     ++bad_beliefs_;
     ROS_WARN_THROTTLE(10.0, "gnss_ingest: belief of %s dropped: no node of this map with a positive mass",
                       msg.picker_id.c_str());
     return;
   }
-  // Normalised through the largest mass first, so masses near the double's range ([1e308, 1e308]) do not sum
-  // to infinity and become all zero.
-  double total = 0.0;
-  for (double& m : masses) total += (m /= peak);
-  for (double& m : masses) m /= total;
   it->second->beliefs.push(msg.header.stamp.toSec(), nodes, masses);
 }
 
@@ -398,8 +389,7 @@ void GnssIngestNode::onPeoplePoses(const geometry_msgs::PoseArray::ConstPtr& msg
   std::size_t k = 0, dropped = 0;
   for (const auto& pose : msg->poses) {
     const Eigen::Vector2d at(pose.position.x, pose.position.y);
-    if (!at.allFinite() ||
-        (options_.max_map_distance > 0.0 && map_->distanceToNearestNode(at) > options_.max_map_distance)) {
+    if (!at.allFinite() || options_.farFromMap(*map_, at)) {
       ++bad_people_;
       ++dropped;
       continue;
@@ -450,12 +440,12 @@ void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped
                       picker.c_str());
     return;
   }
-  if (options_.max_map_distance > 0.0 && map_->distanceToNearestNode(at) > options_.max_map_distance) {
+  if (double off = 0.0; options_.farFromMap(*map_, at, &off)) {
     // As a fix's check: a pose far off the map would be snapped to its nearest node and re-initialise there.
     ++bad_poses_;
     ROS_WARN_THROTTLE(
         5.0, "gnss_ingest: pose of %s dropped: %.0f m from the nearest map node (max_map_distance %.0f m)",
-        picker.c_str(), map_->distanceToNearestNode(at), options_.max_map_distance);
+        picker.c_str(), off, options_.max_map_distance);
     return;
   }
   core::Observation obs;

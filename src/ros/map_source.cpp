@@ -125,11 +125,20 @@ std::string fingerprintOf(const picker_localisation::TopologicalMap& m) {
          std::to_string(m.nodes.size()) + "/" + std::to_string(h);
 }
 
-// One message of type M from `topic`, turned into a map by `convert`; nullptr when none came within a second,
-// when it is the message refused last, or when it is refused now.
-template <typename M, typename Convert>
+// The map a message holds, for start-up and later updates alike; throws topology::MapError when it holds none.
+std::shared_ptr<const topology::TopologicalMap> mapOf(const std_msgs::String& m, const std::string& topic) {
+  return std::make_shared<topology::TopologicalMap>(topology::parseMap(m.data, topic));
+}
+std::shared_ptr<const topology::TopologicalMap> mapOf(const picker_localisation::TopologicalMap& m,
+                                                      const std::string&) {
+  return std::make_shared<topology::TopologicalMap>(fromMsg(m));
+}
+
+// One message of type M from `topic`, turned into a map; nullptr when none came within a second, when it is
+// the message refused last, or when it is refused now.
+template <typename M>
 std::shared_ptr<const topology::TopologicalMap> takeMap(const std::string& topic, ros::NodeHandle& nh,
-                                                        MapRefusals& refusals, Convert convert) {
+                                                        MapRefusals& refusals) {
   const auto msg = ros::topic::waitForMessage<M>(topic, nh, ros::Duration(1.0));
   if (!msg) return nullptr;
   const std::string fingerprint = fingerprintOf(*msg);
@@ -138,7 +147,7 @@ std::shared_ptr<const topology::TopologicalMap> takeMap(const std::string& topic
     return nullptr;
   }
   try {
-    std::shared_ptr<const topology::TopologicalMap> map = convert(*msg);
+    std::shared_ptr<const topology::TopologicalMap> map = mapOf(*msg, topic);
     refusals.taken(*map);
     return map;
   } catch (const topology::MapError& e) {
@@ -164,16 +173,12 @@ std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, r
       const std::string type = topicType(topic);
       std::shared_ptr<const topology::TopologicalMap> map;
       if (type == "picker_localisation/TopologicalMap") {
-        map = takeMap<picker_localisation::TopologicalMap>(topic, nh, refusals, [](const auto& m) {
-          return std::make_shared<topology::TopologicalMap>(fromMsg(m));
-        });
+        map = takeMap<picker_localisation::TopologicalMap>(topic, nh, refusals);
       } else if (type == "std_msgs/String") {
-        map = takeMap<std_msgs::String>(topic, nh, refusals, [&](const std_msgs::String& m) {
-          auto parsed = std::make_shared<topology::TopologicalMap>(topology::parseMap(m.data, topic));
-          ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(),
-                   parsed->name().c_str(), topic.c_str(), parsed->numNodes(), parsed->numLanes());
-          return parsed;
-        });
+        map = takeMap<std_msgs::String>(topic, nh, refusals);
+        if (map)
+          ROS_INFO("%s: map '%s' from %s (tmap2 text): %zu nodes, %zu lanes", name.c_str(), map->name().c_str(),
+                   topic.c_str(), map->numNodes(), map->numLanes());
       } else if (!type.empty()) {
         ROS_FATAL(
             "%s: %s is a %s; a map topic must be picker_localisation/TopologicalMap (topological_map_server) "
@@ -203,8 +208,8 @@ struct MapFollower::Impl {
       : refusals(nh, node, topic), node(std::move(node)), topic(std::move(topic)) {}
 
   // One map message: nothing when it is the current one (or the one refused last), else refused or adopted.
-  template <typename M, typename Convert>
-  void onMessage(const M& msg, Convert convert) {
+  template <typename M>
+  void onMessage(const M& msg) {
     std::string fingerprint = fingerprintOf(msg);
     if (fingerprint == current_fingerprint) {
       refusals.taken(*current);  // the current map re-sent after a refused one: the ERROR is over
@@ -213,7 +218,7 @@ struct MapFollower::Impl {
     if (refusals.alreadyRefused(fingerprint)) return;
     std::shared_ptr<const topology::TopologicalMap> map;
     try {
-      map = convert(msg);
+      map = mapOf(msg, topic);
     } catch (const std::exception& e) {  // topology::MapError, or anything else a conversion meets
       refusals.refuse(fingerprint, e.what(), "keeping the current map");
       return;
@@ -254,18 +259,11 @@ MapFollower::MapFollower(ros::NodeHandle& nh, ros::NodeHandle& pnh,
   Impl* impl = impl_.get();
   const std::string type = topicType(topic);
   if (type == "std_msgs/String") {
-    impl_->sub = nh.subscribe<std_msgs::String>(topic, 1, [impl, topic](const std_msgs::String::ConstPtr& m) {
-      impl->onMessage(*m, [&](const std_msgs::String& text) {
-        return std::make_shared<topology::TopologicalMap>(topology::parseMap(text.data, topic));
-      });
-    });
+    impl_->sub = nh.subscribe<std_msgs::String>(
+        topic, 1, [impl](const std_msgs::String::ConstPtr& m) { impl->onMessage(*m); });
   } else {  // the type obtainMap() read (topological_map_server's), also while nobody publishes
     impl_->sub = nh.subscribe<picker_localisation::TopologicalMap>(
-        topic, 1, [impl](const picker_localisation::TopologicalMap::ConstPtr& m) {
-          impl->onMessage(*m, [](const picker_localisation::TopologicalMap& msg) {
-            return std::make_shared<topology::TopologicalMap>(fromMsg(msg));
-          });
-        });
+        topic, 1, [impl](const picker_localisation::TopologicalMap::ConstPtr& m) { impl->onMessage(*m); });
   }
 }
 

@@ -26,13 +26,7 @@ nbs::NodeMasses massesFromBelief(const picker_localisation::PickerBelief& msg,
     total += v;
   }
   if (rejected) *rejected = bad;
-  // Normalised through the largest mass first: masses near the double's range ([1e308, 1e308]) sum to
-  // infinity and would all become 0.
-  const double peak = m.empty() ? 0.0 : *std::max_element(m.begin(), m.end());
-  if (!(total > 0.0) || !std::isfinite(peak)) return {};
-  total = 0.0;
-  for (double& v : m) total += (v /= peak);
-  for (double& v : m) v /= total;
+  if (!core::normaliseMasses(m)) return {};
   return m;
 }
 

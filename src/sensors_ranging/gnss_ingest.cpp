@@ -253,13 +253,10 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
     return reject(GnssRejection::kOutOfOrder, s.str(), counters_.out_of_order);
   }
 
-  if (options_.max_map_distance > 0.0 && map_->numNodes() > 0) {
-    const double off = map_->distanceToNearestNode(p);
-    if (off > options_.max_map_distance) {
-      std::ostringstream s;
-      s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance << " m)";
-      return reject(GnssRejection::kOffMap, s.str(), counters_.off_map);
-    }
+  if (double off = 0.0; options_.farFromMap(*map_, p, &off)) {
+    std::ostringstream s;
+    s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance << " m)";
+    return reject(GnssRejection::kOffMap, s.str(), counters_.off_map);
   }
 
   bool after_blackout = false;

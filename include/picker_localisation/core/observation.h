@@ -74,5 +74,10 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
 // node applies to a covariance it receives.
 bool isCovariance2d(const Eigen::Matrix2d& c);
 
+// Scales non-negative masses to sum to 1, through their largest first, so masses near the double's range
+// ([1e308, 1e308]) do not sum to infinity and all become 0. False, masses unusable, when the largest is not
+// finite and positive. The one normalisation of beliefs a node receives.
+bool normaliseMasses(std::vector<double>& masses);
+
 }  // namespace core
 }  // namespace picker_localisation

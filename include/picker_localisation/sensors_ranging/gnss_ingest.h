@@ -87,6 +87,14 @@ struct GnssIngestOptions {
   // it neither re-anchors the gate nor snaps the belief to the nearest node (a 50 km glitch moved it 23 m).
   // 0 disables. 50 m: ten times the worst Table I bias, beyond any lane a picker can be in.
   double max_map_distance = 50.0;
+  // True when `p` (map frame) is farther than max_map_distance from every node of `map` (never when 0); the
+  // distance goes to *distance. One rule for fixes, picker poses and other detectors' people.
+  bool farFromMap(const topology::TopologicalMap& map, const Eigen::Vector2d& p, double* distance = nullptr) const {
+    if (!(max_map_distance > 0.0) || map.numNodes() == 0) return false;
+    const double d = map.distanceToNearestNode(p);
+    if (distance) *distance = d;
+    return d > max_map_distance;
+  }
   GnssBiasOptions bias;             // the device's bias estimate (gnss_bias.h), keys bias_*
   PickerAssociationOptions association;  // identity of anonymous people detections, keys association_*
 
