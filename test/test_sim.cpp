@@ -140,6 +140,90 @@ TEST(LaneTour, SerpentineOnPolytunnel) {
   EXPECT_EQ(tour2.front(), layout.lanes()[2].entry_end());
 }
 
+// The lane sequence of a tour: the layout order of each lane entered, and how often each lane node is passed.
+std::vector<int> laneSequence(const topology::TopologicalMap& map, const LaneLayout& layout,
+                              const std::vector<NodeIndex>& tour) {
+  std::vector<int> sequence;
+  for (NodeIndex n : tour) {
+    const int o = layout.orderOf(map.lane(n));
+    if (o >= 0 && (sequence.empty() || sequence.back() != o)) sequence.push_back(o);
+  }
+  return sequence;
+}
+
+TEST(LaneTour, SkipOneWalksEveryOtherLane) {
+  const auto map = polytunnel(8, 8);
+  LaneLayout layout(map);
+  const auto tour = buildLaneTour(map, layout, 0, {}, LaneOrder::kSkipOne);
+  for (std::size_t k = 0; k < tour.size(); ++k)
+    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()])) << k;
+  // Lanes 0, 2, 4, 6 walked end to end in alternating directions; the others at most passed at an end.
+  std::vector<int> walked;
+  for (const auto& lane : layout.lanes()) {
+    std::size_t inside = 0;
+    for (NodeIndex n : tour) inside += map.lane(n) == lane.lane ? 1 : 0;
+    if (inside == lane.nodes.size()) walked.push_back(layout.orderOf(lane.lane));
+    EXPECT_TRUE(inside == lane.nodes.size() || inside < lane.nodes.size() / 2)
+        << layout.orderOf(lane.lane) << ": " << inside;
+  }
+  EXPECT_EQ(walked, (std::vector<int>{0, 2, 4, 6}));
+  EXPECT_EQ(tour.front(), layout.lanes()[0].entry_end());
+  const auto& lane2 = layout.lanes()[2].nodes;
+  EXPECT_NE(std::find(tour.begin(), tour.end(), lane2.back()), tour.end());
+  // The second lane walked (lane 2) is walked far end first.
+  const auto far = std::find(tour.begin(), tour.end(), lane2.back());
+  const auto entry = std::find(tour.begin(), tour.end(), lane2.front());
+  EXPECT_LT(far - tour.begin(), entry - tour.begin());
+}
+
+TEST(LaneTour, OutAndBackReturnsByTheSameLane) {
+  const auto map = polytunnel(4, 8);
+  LaneLayout layout(map);
+  const auto tour = buildLaneTour(map, layout, 0, {}, LaneOrder::kOutAndBack);
+  for (std::size_t k = 0; k < tour.size(); ++k)
+    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()])) << k;
+  EXPECT_EQ(laneSequence(map, layout, tour), (std::vector<int>{0, 1, 2, 3}));
+  for (const auto& lane : layout.lanes()) {
+    std::vector<NodeIndex> seen;
+    for (NodeIndex n : tour)
+      if (map.lane(n) == lane.lane) seen.push_back(n);
+    std::vector<NodeIndex> expected = lane.nodes;
+    expected.insert(expected.end(), lane.nodes.rbegin() + 1, lane.nodes.rend());
+    EXPECT_EQ(seen, expected) << "lane " << layout.orderOf(lane.lane);
+  }
+  EXPECT_EQ(parseLaneOrder("out_and_back"), LaneOrder::kOutAndBack);
+  EXPECT_STREQ(toString(LaneOrder::kSkipOne), "skip_one");
+  EXPECT_THROW(parseLaneOrder("zigzag"), std::invalid_argument);
+}
+
+TEST(PickerMotion, LongStopsHoldThePickerForMinutes) {
+  const auto map = polytunnel(2, 20);
+  LaneLayout layout(map);
+  PickerMotionParams params;
+  params.p_reverse = 0.0;
+  params.long_stop_probability = 0.2;
+  params.long_stop_mean = 120.0;
+  SimulatedPicker picker(map, buildLaneTour(map, layout, 0), params, 5);
+  double stopped = 0.0, longest = 0.0, run = 0.0;
+  for (int k = 0; k < 36000; ++k) {  // one hour at 0.1 s
+    picker.step(0.1);
+    const bool still = picker.state().dwelling;
+    run = still ? run + 0.1 : 0.0;
+    stopped += still ? 0.1 : 0.0;
+    longest = std::max(longest, run);
+  }
+  // A lane node every ~6 s of walking, a fifth of them a 2 min stop: stopped most of the hour.
+  EXPECT_GT(stopped, 1800.0);
+  EXPECT_GT(longest, 120.0);
+  PickerMotionParams walking = params;
+  walking.long_stop_probability = 0.0;
+  SimulatedPicker other(map, buildLaneTour(map, layout, 0), walking, 5);
+  for (int k = 0; k < 3600; ++k) {
+    other.step(0.1);
+    EXPECT_FALSE(other.state().dwelling);
+  }
+}
+
 TEST(LaneTour, MapWithoutLanesUsesWaypoints) {
   const auto map = gridMap();
   EXPECT_EQ(map.numLanes(), 0u);
@@ -393,6 +477,37 @@ TEST(GnssModel, BlackoutsLastThirtyToSixtySeconds) {
   // Onsets: one per blackout_mean_interval of non-blackout time -> share of time off = 45 / (600 + 45).
   EXPECT_NEAR(off_time / n, 45.0 / 645.0, 0.01);
   EXPECT_NEAR((n - off_time) / log.size(), 600.0, 60.0);
+}
+
+TEST(GnssModel, DriftRedrawnAfterABlackoutWhenAsked) {
+  // With a correlation time of a day the drift barely moves by itself: a jump at the end of a blackout is the
+  // redraw. Without the option the drift continues where it was.
+  GnssNoiseParams params;
+  params.offset_max = 0.0;
+  params.white_std = 0.0;
+  params.drift_tau = 86400.0;
+  params.blackout_mean_interval = 300.0;
+  for (bool redraw : {false, true}) {
+    params.redraw_after_blackout = redraw;
+    GnssErrorModel m(params, 21);
+    std::optional<Eigen::Vector2d> before, last;
+    double largest_jump = 0.0;
+    for (int k = 1; k <= 20000; ++k) {
+      const auto e = m.sample(k * 1.0);
+      if (!e) {
+        if (last) before = last;
+        last.reset();
+        continue;
+      }
+      if (!last && before) largest_jump = std::max(largest_jump, (*e - *before).norm());
+      last = e;
+    }
+    ASSERT_GT(m.blackouts().size(), 10u);
+    if (redraw)
+      EXPECT_GT(largest_jump, 2.5);  // |N(0, 2.5^2 I) - N(0, 2.5^2 I)| over > 10 blackouts
+    else
+      EXPECT_LT(largest_jump, 0.6);  // 60 s of a one-day process: ~0.1 m per axis
+  }
 }
 
 TEST(GnssModel, FixesGoThroughTheDatum) {

@@ -1107,11 +1107,81 @@ TEST(TpfGnssBias, KalmanUpdatePerParticleAndPredictiveWeights) {
     EXPECT_NEAR(q.bias_y, 0.0, 1e-6);
     EXPECT_NEAR(q.bias_variance, 2.0 * 1.75 / s, 1e-5);
   }
-  // The next fix 10 s later: each variance grows by drift_rate * 10 before the update.
+  // The next fix 10 s later: the bias is the Gauss-Markov process of the device prior (mean m = 0.5, P = 2,
+  // initial rate Q = 0.01, correlation time 2 P / Q = 400 s): before the update b -> m + a (b - m) and
+  // var -> a^2 var + (1 - a^2) P with a = exp(-10 / 400).
+  std::map<NodeIndex, float> bias_before;
+  for (const Particle& q : f.particles()) bias_before[q.node] = q.bias_x;
   core::Observation later = biasedFix(*map, 10.0, {3.5, 0.0}, 1.0, {0.5, 0.0}, 2.0, 0.01);
   ASSERT_TRUE(f.update(later).ok());
-  const double v0 = 2.0 * 1.75 / s + 0.1, v1 = v0 * 1.75 / (v0 + 1.75);
-  for (const Particle& q : f.particles()) EXPECT_NEAR(q.bias_variance, v1, 1e-5);
+  const double a = std::exp(-10.0 / 400.0);
+  const double v0 = a * a * 2.0 * 1.75 / s + (1.0 - a * a) * 2.0, v1 = v0 * 1.75 / (v0 + 1.75);
+  for (const Particle& q : f.particles()) {
+    EXPECT_NEAR(q.bias_variance, v1, 1e-5);
+    const double predicted = 0.5 + a * (bias_before[q.node] - 0.5);
+    const double y = 4.0 - map->position2d(q.node).x() - predicted;
+    EXPECT_NEAR(q.bias_x, predicted + v0 / (v0 + 1.75) * y, 1e-4);
+  }
+}
+
+namespace {
+// Share of the belief's mass in the lane of `node`.
+double laneMass(const topology::TopologicalMap& map, const tpf::Belief& b, NodeIndex node) {
+  double share = 0.0;
+  for (std::size_t j = 0; j < b.nodes.size(); ++j)
+    if (map.lane(b.nodes[j]) == map.lane(node)) share += b.masses[j];
+  return share;
+}
+}  // namespace
+
+TEST(TpfGnssBias, LaneSwapsKeepHypothesesTheFixesCannotTellApart) {
+  // Every particle starts in lane 5 (one sighting); then 300 s of phone fixes halfway between lanes 5 and 6
+  // with the phone's prior (3.2 m per axis): the fixes cannot tell the two lanes apart. Static particles
+  // never leave lane 5 by themselves (no edge crosses a lane); with lane swaps, lane 6 gets about as much
+  // mass as lane 5 (and lanes 4 and 7, 2.25 m from the fixes, less). With a tight prior (a robot measured the
+  // bias) a swap would need a 1.5 m error the prior rules out: none.
+  auto map = polytunnel();
+  const NodeIndex here = *map->index("r5_5"), there = *map->index("r6_5");
+  const Eigen::Vector2d between = 0.5 * (map->position2d(here) + map->position2d(there));
+  auto shares = [&](double rate, double prior_variance) {
+    TpfParams p = staticParams(1000);
+    p.gnss_bias_state = true;
+    p.lane_swap_rate = rate;
+    p.lane_swap_memory = 30.0;  // the sighting pauses swaps this long
+    TopologicalParticleFilter f(map, p, 5);
+    EXPECT_TRUE(f.update(obsAt(0.0, {here}, {1.0}, true, "uwb")).ok());
+    for (int k = 1; k <= 300; ++k)
+      EXPECT_TRUE(
+          f.update(biasedFix(*map, k, between, 9.0, {0.0, 0.0}, prior_variance, 2.0 * 6.25 / 300.0)).ok());
+    return std::make_pair(laneMass(*map, f.belief(), here), laneMass(*map, f.belief(), there));
+  };
+  const auto off = shares(0.0, 10.25);
+  EXPECT_GT(off.first, 0.999);
+  const auto on = shares(0.1, 10.25);
+  EXPECT_GT(on.second, 0.15);
+  EXPECT_GT(on.first, 0.15);
+  EXPECT_GT(on.first + on.second, 0.4);
+  const auto tight = shares(0.1, 0.05);
+  EXPECT_GT(tight.first, 0.999);
+}
+
+TEST(TpfGnssBias, LaneSwapsPauseWhileARobotSeesThePicker) {
+  // The same ambiguous fixes, but a UWB fix on lane 5 every 20 s (within lane_swap_memory): lane 5 keeps it.
+  auto map = polytunnel();
+  const NodeIndex here = *map->index("r5_5"), there = *map->index("r6_5");
+  const Eigen::Vector2d between = 0.5 * (map->position2d(here) + map->position2d(there));
+  TpfParams p = staticParams(1000);
+  p.gnss_bias_state = true;
+  p.lane_swap_memory = 30.0;
+  TopologicalParticleFilter f(map, p, 5);
+  for (int k = 0; k <= 300; ++k) {
+    if (k % 20 == 0) ASSERT_TRUE(f.update(obsAt(k, {here}, {1.0}, true, "uwb")).ok());
+    if (k > 0)
+      ASSERT_TRUE(
+          f.update(biasedFix(*map, k + 0.5, between, 9.0, {0.0, 0.0}, 10.25, 2.0 * 6.25 / 300.0)).ok());
+  }
+  EXPECT_GT(laneMass(*map, f.belief(), here), 0.999);
+  EXPECT_LT(laneMass(*map, f.belief(), there), 1e-3);
 }
 
 TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {

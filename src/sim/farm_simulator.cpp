@@ -92,7 +92,7 @@ FarmSimulator::FarmSimulator(const topology::TopologicalMap& map, SimConfig conf
         start = (i * L) / n_pickers;
         start -= start % 2;  // even positions are walked from the entry end (the paper's left side)
       }
-      tour = buildLaneTour(map, layout_, start);
+      tour = buildLaneTour(map, layout_, start, {}, config_.picker_motion.lane_order);
     } else {
       std::mt19937_64 wrng(deriveSeed(seed, streamId(kWaypoints, i)));
       std::uniform_int_distribution<std::size_t> pick(0, big_nodes.size() - 1);

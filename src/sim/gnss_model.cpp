@@ -48,6 +48,10 @@ void GnssErrorModel::advanceTo(double t) {
     } else {
       blackout_ = false;
       blackout_log_.emplace_back(blackout_start_, next_transition_);
+      if (params_.redraw_after_blackout) {
+        std::normal_distribution<double> stationary(0.0, params_.drift_std);
+        drift_ = Eigen::Vector2d(stationary(rng_), stationary(rng_));
+      }
       std::exponential_distribution<double> gap(1.0 / params_.blackout_mean_interval);
       next_transition_ += gap(rng_);
     }

@@ -147,18 +147,42 @@ bool appendPath(const topology::TopologicalMap& map, std::vector<NodeIndex>& tou
 }
 }  // namespace
 
+LaneOrder parseLaneOrder(const std::string& name) {
+  if (name == "serpentine") return LaneOrder::kSerpentine;
+  if (name == "skip_one") return LaneOrder::kSkipOne;
+  if (name == "out_and_back") return LaneOrder::kOutAndBack;
+  throw std::invalid_argument("lane_order '" + name + "': must be serpentine, skip_one or out_and_back");
+}
+
+const char* toString(LaneOrder order) {
+  switch (order) {
+    case LaneOrder::kSkipOne:
+      return "skip_one";
+    case LaneOrder::kOutAndBack:
+      return "out_and_back";
+    case LaneOrder::kSerpentine:
+      break;
+  }
+  return "serpentine";
+}
+
 std::vector<NodeIndex> buildLaneTour(const topology::TopologicalMap& map, const LaneLayout& layout,
-                                     std::size_t start_lane,
-                                     const std::vector<NodeIndex>& fallback_waypoints) {
+                                     std::size_t start_lane, const std::vector<NodeIndex>& fallback_waypoints,
+                                     LaneOrder order) {
   std::vector<NodeIndex> tour;
   if (!layout.empty()) {
     const auto& lanes = layout.lanes();
     const std::size_t L = lanes.size();
     start_lane %= L;
-    for (std::size_t k = 0; k < L; ++k) {
-      const std::size_t pos = (start_lane + k) % L;
+    const std::size_t stride = order == LaneOrder::kSkipOne && L > 1 ? 2 : 1;
+    for (std::size_t k = 0; k * stride < L; ++k) {
+      const std::size_t pos = (start_lane + k * stride) % L;
       std::vector<NodeIndex> nodes = lanes[pos].nodes;
-      if (pos % 2 == 1) std::reverse(nodes.begin(), nodes.end());
+      if (order == LaneOrder::kOutAndBack) {
+        nodes.insert(nodes.end(), lanes[pos].nodes.rbegin() + 1, lanes[pos].nodes.rend());
+      } else if ((stride == 1 ? pos : k) % 2 == 1) {
+        std::reverse(nodes.begin(), nodes.end());
+      }
       // A lane not reachable from the tour so far is skipped; within a lane, consecutive nodes are joined by
       // shortest paths (they are adjacent on a chain lane).
       if (!tour.empty() && map.shortestPath(tour.back(), nodes.front()).empty()) continue;

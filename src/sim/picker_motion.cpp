@@ -116,6 +116,13 @@ void SimulatedPicker::arrive() {
     state_.speed = 0.0;
     dwell_until_ = time_ + d(rng_);
   }
+  if (params_.long_stop_probability > 0.0 && lane != topology::kNoLane &&
+      std::bernoulli_distribution(std::min(params_.long_stop_probability, 1.0))(rng_)) {
+    std::exponential_distribution<double> d(1.0 / params_.long_stop_mean);
+    state_.dwelling = true;
+    state_.speed = 0.0;
+    dwell_until_ = std::max(dwell_until_, time_) + d(rng_);
+  }
 }
 
 void SimulatedPicker::decideReversal() {

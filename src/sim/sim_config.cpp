@@ -62,6 +62,12 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                                  {"t_reverse", set(c.picker_motion.t_reverse)},
                                  {"reverse_step", set(c.picker_motion.reverse_step)},
                                  {"dwell_mean", set(c.picker_motion.dwell_mean)},
+                                 {"long_stop_probability", set(c.picker_motion.long_stop_probability)},
+                                 {"long_stop_mean", set(c.picker_motion.long_stop_mean)},
+                                 {"lane_order",
+                                  [&c](const YAML::Node& n) {
+                                    c.picker_motion.lane_order = parseLaneOrder(n.as<std::string>());
+                                  }},
                                  {"leg_radius", set(c.picker_motion.leg_radius)},
                                  {"leg_spread", set(c.picker_motion.leg_spread)},
                                  {"stride_length", set(c.picker_motion.stride_length)},
@@ -76,6 +82,7 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                         {"blackout_min", set(c.gnss.blackout_min)},
                         {"blackout_max", set(c.gnss.blackout_max)},
                         {"blackout_emits_no_fix", set(c.gnss.blackout_emits_no_fix)},
+                        {"redraw_after_blackout", set(c.gnss.redraw_after_blackout)},
                         {"rate", set(c.gnss.rate)},
                         {"reported_std", set(c.gnss.reported_std)},
                         {"antenna_height", set(c.gnss.antenna_height)}},
@@ -144,6 +151,11 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                          "enable")},
   };
   applySection(root, top, source, "");
+  const PickerMotionParams& m = c.picker_motion;
+  if (!(m.long_stop_probability >= 0.0 && m.long_stop_probability <= 1.0))
+    throw std::runtime_error(source + ": picker_motion.long_stop_probability must be in [0, 1]");
+  if (!(m.long_stop_mean > 0.0))
+    throw std::runtime_error(source + ": picker_motion.long_stop_mean must be > 0");
 }
 
 SimConfig loadSimConfig(const std::string& path) {

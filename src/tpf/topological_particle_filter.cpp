@@ -79,6 +79,49 @@ struct TopologicalParticleFilter::MotionGraph {
   std::vector<Eigen::Vector2d> lane_path_shift;  // adjacent lane's end minus the lane end left, m
   std::vector<std::uint32_t> exit_offsets, exit_paths;
 
+  // Lane hypotheses (TpfParams::lane_swap_rate): per lane node, the nearest node of another lane on each side
+  // of its lane (across[2 n], across[2 n + 1]; kInvalidNode when none), at most max_distance away and within
+  // 45 degrees of the lane's normal.
+  std::vector<NodeIndex> across;
+
+  // Unit normal of a lane's axis (principal axis of its node positions).
+  static Eigen::Vector2d laneNormal(const topology::TopologicalMap& map,
+                                    const std::vector<NodeIndex>& nodes) {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (NodeIndex i : nodes) mean += map.position2d(i);
+    mean /= static_cast<double>(nodes.size());
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (NodeIndex i : nodes) {
+      const Eigen::Vector2d d = map.position2d(i) - mean;
+      cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    const Eigen::Vector2d axis = eig.eigenvectors().col(1);
+    return {-axis.y(), axis.x()};
+  }
+
+  void buildAcrossLanes(const topology::TopologicalMap& map, double max_distance) {
+    across.assign(2 * map.numNodes(), topology::kInvalidNode);
+    for (std::size_t l = 0; l < map.numLanes(); ++l) {
+      const auto lane = static_cast<topology::LaneIndex>(l);
+      const auto& nodes = map.laneNodes(lane);
+      if (nodes.size() < 2) continue;
+      const Eigen::Vector2d normal = laneNormal(map, nodes);
+      for (NodeIndex e : nodes) {
+        const Eigen::Vector2d pe = map.position2d(e);
+        double best[2] = {max_distance, max_distance};
+        for (NodeIndex k : map.nodesWithin(pe, max_distance)) {
+          if (map.lane(k) < 0 || map.lane(k) == lane) continue;
+          const Eigen::Vector2d d = map.position2d(k) - pe;
+          const double side = d.dot(normal), distance = d.norm();
+          if (std::abs(side) < std::sqrt(0.5) * distance) continue;  // more along the lane than across it
+          const int s = side > 0.0 ? 0 : 1;
+          if (distance < best[s]) best[s] = distance, across[2 * e + s] = k;
+        }
+      }
+    }
+  }
+
   void buildLaneChangePaths(const topology::TopologicalMap& map, bool directed, int max_hops) {
     const std::size_t n = map.numNodes();
     std::vector<std::vector<std::uint32_t>> exits(n);
@@ -88,18 +131,8 @@ struct TopologicalParticleFilter::MotionGraph {
       const auto lane = static_cast<topology::LaneIndex>(l);
       const auto& nodes = map.laneNodes(lane);
       if (nodes.size() < 2) continue;
-      // Lane axis by PCA of the node positions; "sides" are the two half-planes of its normal.
-      Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-      for (NodeIndex i : nodes) mean += map.position2d(i);
-      mean /= static_cast<double>(nodes.size());
-      Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-      for (NodeIndex i : nodes) {
-        const Eigen::Vector2d d = map.position2d(i) - mean;
-        cov += d * d.transpose();
-      }
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-      const Eigen::Vector2d axis = eig.eigenvectors().col(1);
-      const Eigen::Vector2d normal(-axis.y(), axis.x());
+      // "Sides" are the two half-planes of the lane's normal.
+      const Eigen::Vector2d normal = laneNormal(map, nodes);
       for (NodeIndex e : nodes) {
         int in_lane = 0;
         for (NodeIndex k : map.motionNeighbours(e, directed)) in_lane += map.lane(k) == lane ? 1 : 0;
@@ -204,7 +237,8 @@ struct TopologicalParticleFilter::MotionGraph {
     return 0;
   }
 
-  MotionGraph(const topology::TopologicalMap& map, bool directed, bool lane_change, int max_hops) {
+  MotionGraph(const topology::TopologicalMap& map, bool directed, bool lane_change, int max_hops,
+              double lane_swap_distance) {
     const std::size_t n = map.numNodes();
     offsets.resize(n + 1, 0);
     for (NodeIndex i = 0; i < n; ++i) {
@@ -233,6 +267,7 @@ struct TopologicalParticleFilter::MotionGraph {
       median_arc_length = lengths[lengths.size() / 2];
     }
     if (lane_change) buildLaneChangePaths(map, directed, max_hops);
+    if (lane_swap_distance > 0.0) buildAcrossLanes(map, lane_swap_distance);
   }
 };
 
@@ -270,8 +305,10 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
 void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::TopologicalMap> map) {
   // What can throw (std::bad_alloc) first, into locals; then no-throw swaps: a failure leaves the filter as it was.
   auto graph = std::make_shared<const MotionGraph>(
-      *map, params_.directed_motion, params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
-      params_.lane_change_max_hops);
+      *map, params_.directed_motion,
+      params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
+      params_.lane_change_max_hops,
+      params_.gnss_bias_state && params_.lane_swap_rate > 0.0 ? params_.lane_swap_max_distance : 0.0);
   std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
   std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0), node_b(map->numNodes(), 0.0);
   map_.swap(map);
@@ -311,7 +348,8 @@ void TopologicalParticleFilter::reset() {
   touched_.clear();
   belief_ = Belief();
   bias_stamp_ = 0.0;
-  bias_variance_cap_ = 0.0;
+  bias_step_ = 0.0;
+  other_sensor_stamp_ = -std::numeric_limits<double>::infinity();
   unconnected_p_ = params_.unconnected_jump_probability;
   belief_.unconnected_jump_probability = unconnected_p_;
 }
@@ -460,6 +498,7 @@ UpdateResult TopologicalParticleFilter::update(const core::Observation& obs) {
     dt = obs.stamp - belief_.stamp;
   }
   fuse(obs, dt, result);
+  if (!params_.usesBiasState(obs.sensor)) other_sensor_stamp_ = std::max(other_sensor_stamp_, obs.stamp);
   if (result.status == UpdateStatus::kReordered)
     ++counters_.reordered;
   else
@@ -825,6 +864,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   }
 
   resample(total);  // Eq. 11
+  if (bias_state) swapLanes(obs);
   addNoise();       // Eq. 12, leaves the particle counts per node in node_scratch_b_ / touched_
   // Entropy of the resampled particles (Alg. 1 l. 12).
   const double inv_n = 1.0 / static_cast<double>(particles_.size());
@@ -841,41 +881,102 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
 
 void TopologicalParticleFilter::weighWithBiasState(const core::Observation& obs) {
   // Rao-Blackwellised GNSS update (tpf_params.h, gnss_bias_state). Per axis and particle: the raw fix
-  // z = p(q) + b + e, e ~ N(0, R), R = gnss_bias_fix_std^2 + spacing^2 / 12; b a random walk of rate Q (the
-  // fix's bias_drift_rate, 2 drift_std^2 / drift_tau of gnss_ingest's device model). Predict var += Q dt
-  // (capped), weigh by N(z - p - b; 0, S I), S = var + R (normalised: particles with different variances
-  // compete fairly), update b += K (z - p - b), var = (1 - K) var, K = var / S.
+  // z = p(q) + b + e, e ~ N(0, R), R = gnss_bias_fix_std^2 + spacing^2 / 12. The device model (gnss_ingest,
+  // carried by the fix) says b ~ N(m, P) (m = bias_removed: 0, or the estimate after a sighting; P per axis
+  // from bias_covariance) and that b wanders at Q = bias_drift_rate (2 drift_std^2 / drift_tau). b is the
+  // Gauss-Markov process with that stationary law and that initial rate, correlation time T = 2 P / Q:
+  //   predict  b <- m + a (b - m),  var <- a^2 var + (1 - a^2) P,  a = exp(-dt / T)
+  // then weigh by N(z - p - b; 0, S I), S = var + R (normalised: particles with different variances compete
+  // fairly), update b += K (z - p - b), var = (1 - K) var, K = var / S.
+  // Why mean-reverting and not a random walk (what we had): with a random walk capped at P every particle
+  // forgets the prior within minutes, a lane 1.5 m from the truth explains the fixes exactly as well as the
+  // right one (its bias simply 1.5 m larger), and which lane the particles settle in is left to resampling
+  // noise: pickers held in a wrong lane for a whole walk, where the raw fix was right 75 % of the time. The
+  // stationary prior keeps weighing the bias each lane implies against the device's known error size at
+  // every fix, so the lane closer to the fixes keeps its evidence unless the motion (lane changes) says
+  // otherwise.
   const Eigen::Vector2d raw = *obs.position + *obs.bias_removed;
   const double prior_variance = std::max(0.5 * obs.bias_covariance.trace(), 0.0);
-  bias_variance_cap_ = std::max(bias_variance_cap_, prior_variance);
   const double dt = std::max(0.0, obs.stamp - bias_stamp_);
+  bias_step_ = bias_stamp_ > 0.0 ? dt : 0.0;
   bias_stamp_ = std::max(bias_stamp_, obs.stamp);
-  const double grow = obs.bias_drift_rate * dt, cap = std::max(bias_variance_cap_, 1e-6);
+  // a = 1 (no reversion, no growth) for a device without drift or without a prior.
+  const double decay = obs.bias_drift_rate > 0.0 && prior_variance > 0.0
+                           ? std::exp(-dt * obs.bias_drift_rate / (2.0 * prior_variance))
+                           : 1.0;
   const double r = bias_fix_variance_;
-  const float prior_x = static_cast<float>(obs.bias_removed->x()),
-              prior_y = static_cast<float>(obs.bias_removed->y());
+  const double prior_x = obs.bias_removed->x(), prior_y = obs.bias_removed->y();
+  const float forget = static_cast<float>(std::exp(-dt / params_.lane_swap_memory)),
+              step = static_cast<float>(dt);
   double best = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
-    double var;
+    double var, bx, by;
     if (p.bias_variance < 0.0f) {
-      p.bias_x = prior_x;
-      p.bias_y = prior_y;
+      bx = prior_x;
+      by = prior_y;
       var = prior_variance;
+      p.bias_integral_x = p.bias_integral_y = p.bias_time = 0.0f;
     } else {
-      var = std::min(static_cast<double>(p.bias_variance) + grow, cap);
+      bx = prior_x + decay * (p.bias_x - prior_x);
+      by = prior_y + decay * (p.bias_y - prior_y);
+      var = decay * decay * p.bias_variance + (1.0 - decay * decay) * prior_variance;
     }
     const Eigen::Vector2d node = map_->position2d(p.node);
-    const double yx = raw.x() - node.x() - p.bias_x, yy = raw.y() - node.y() - p.bias_y;
+    const double yx = raw.x() - node.x() - bx, yy = raw.y() - node.y() - by;
     const double s = var + r, k = var / s;
     const double log_density = -0.5 * (yx * yx + yy * yy) / s - std::log(s);
     weights_[i] = log_density;
     best = std::max(best, log_density);
-    p.bias_x += static_cast<float>(k * yx);
-    p.bias_y += static_cast<float>(k * yy);
+    p.bias_x = static_cast<float>(bx + k * yx);
+    p.bias_y = static_cast<float>(by + k * yy);
     p.bias_variance = static_cast<float>(var * r / s);
+    p.bias_integral_x = forget * p.bias_integral_x + step * static_cast<float>(p.bias_x - prior_x);
+    p.bias_integral_y = forget * p.bias_integral_y + step * static_cast<float>(p.bias_y - prior_y);
+    p.bias_time = forget * p.bias_time + step;
   }
   for (double& w : weights_) w = std::exp(w - best);
+}
+
+void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
+  // Metropolis-Hastings move (tpf_params.h, lane_swap_rate): a particle at lane node n with bias b proposes
+  // the nearest node n' of the adjacent lane on a side drawn at random, with bias b' = b + p(n) - p(n'),
+  // which predicts every fix as b did; accepted with min(1, N(b'; m, P) / N(b; m, P)), the device prior of
+  // the fix. The proposal is symmetric where the lanes' nodes face each other (evenly spaced parallel lanes);
+  // where they are staggered it is nearly so.
+  const double prior_variance = 0.5 * obs.bias_covariance.trace();
+  if (graph_->across.empty() || bias_step_ <= 0.0 || !(prior_variance > 1e-6)) return;
+  // Another sensor (a robot's LiDAR, RFID, UWB) told the lane recently: that evidence is not in the bias path
+  // the acceptance weighs, so swaps would undo it (measured: Table II rows with robot sensing lost
+  // 0.08-0.10).
+  if (obs.stamp - other_sensor_stamp_ < params_.lane_swap_memory) return;
+  const double propose = -std::expm1(-params_.lane_swap_rate * bias_step_);
+  if (!(propose > 0.0)) return;
+  const Eigen::Vector2d m = *obs.bias_removed;
+  const double inv_two_p = 0.5 / prior_variance;
+  // Path term: shifting the whole recent bias path by d changes the Gauss-Markov path density by
+  // -(2 d.A + |d|^2 T) / (4 P tau), A = integral of (b - m) dt, T = integral of dt, tau = 2 P / Q.
+  const double inv_four_p_tau =
+      obs.bias_drift_rate > 0.0 ? obs.bias_drift_rate / (8.0 * prior_variance * prior_variance) : 0.0;
+  std::geometric_distribution<std::size_t> gap(std::min(propose, 1.0));
+  for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
+    Particle& p = particles_[i];
+    if (p.bias_variance < 0.0f || p.lane_change != 0) continue;
+    const NodeIndex to = graph_->across[2 * p.node + (rng_() & 1u)];
+    if (to == topology::kInvalidNode) continue;
+    const Eigen::Vector2d shift = map_->position2d(p.node) - map_->position2d(to);
+    const Eigen::Vector2d b(p.bias_x, p.bias_y), moved = b + shift;
+    const Eigen::Vector2d integral(p.bias_integral_x, p.bias_integral_y);
+    const double log_ratio = ((b - m).squaredNorm() - (moved - m).squaredNorm()) * inv_two_p -
+                             (2.0 * shift.dot(integral) + shift.squaredNorm() * p.bias_time) * inv_four_p_tau;
+    if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
+    p.node = to;
+    p.bias_x = static_cast<float>(moved.x());
+    p.bias_y = static_cast<float>(moved.y());
+    p.bias_integral_x += static_cast<float>(shift.x() * p.bias_time);
+    p.bias_integral_y += static_cast<float>(shift.y() * p.bias_time);
+    // Velocity, dwell and side memory stay: the hypothesis is the same walk one lane over.
+  }
 }
 
 void TopologicalParticleFilter::resample(double total) {

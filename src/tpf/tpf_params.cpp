@@ -92,6 +92,12 @@ std::string TpfParams::validate() const {
   if (!finite_nonneg(reorder_window)) return core::badValue("reorder_window", reorder_window, ">= 0");
   if (!(gnss_bias_fix_std > 0.0) || !std::isfinite(gnss_bias_fix_std))
     return core::badValue("gnss_bias_fix_std", gnss_bias_fix_std, "finite and > 0");
+  if (!(lane_swap_rate >= 0.0 && lane_swap_rate <= 1.0))
+    return core::badValue("lane_swap_rate", lane_swap_rate, "in [0, 1] per s");
+  if (!(lane_swap_max_distance > 0.0 && lane_swap_max_distance <= 20.0))
+    return core::badValue("lane_swap_max_distance", lane_swap_max_distance, "in (0, 20] m");
+  if (!(lane_swap_memory > 0.0 && lane_swap_memory <= 86400.0))
+    return core::badValue("lane_swap_memory", lane_swap_memory, "in (0, 86400] s");
   return "";
 }
 
@@ -177,6 +183,9 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "gnss_bias_state",
                                                 "gnss_bias_sensors",
                                                 "gnss_bias_fix_std",
+                                                "lane_swap_rate",
+                                                "lane_swap_max_distance",
+                                                "lane_swap_memory",
                                                 "resampling",
                                                 "motion_model",
                                                 "sensor_gammas",
@@ -245,6 +254,9 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "gnss_bias_state", p.gnss_bias_state);
   read(node, "gnss_bias_sensors", p.gnss_bias_sensors);
   read(node, "gnss_bias_fix_std", p.gnss_bias_fix_std);
+  read(node, "lane_swap_rate", p.lane_swap_rate);
+  read(node, "lane_swap_max_distance", p.lane_swap_max_distance);
+  read(node, "lane_swap_memory", p.lane_swap_memory);
   if (node["method"]) {  // mode switches win
     try {
       p = presetForMethod(node["method"].as<std::string>(), p);

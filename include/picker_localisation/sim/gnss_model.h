@@ -13,7 +13,8 @@
 //  - blackouts (Table I gps_off): onsets form a Poisson process of rate 1 / blackout_mean_interval
 //    (default one per 600 s of non-blackout time); each lasts U(blackout_min, blackout_max) = U(30, 60) s.
 //    During a blackout the fix has status NO_FIX and NaN lat/lon/alt (or no fix at all,
-//    `blackout_emits_no_fix` false). The drift keeps evolving through a blackout.
+//    `blackout_emits_no_fix` false). The drift keeps evolving through a blackout, or (redraw_after_blackout)
+//    is drawn afresh from its stationary distribution when the blackout ends.
 // The reported covariance is diagonal with reported_std^2 on east/north and (2 reported_std)^2 on up.
 #pragma once
 
@@ -41,6 +42,9 @@ struct GnssNoiseParams {
   double blackout_min = 30.0;             // s, blackout duration ~ U(blackout_min, blackout_max)
   double blackout_max = 60.0;             // s
   bool blackout_emits_no_fix = true;      // during a blackout: a NO_FIX message (true) or nothing (false)
+  // At the end of a blackout the drift is drawn afresh from its stationary distribution (a phone that lost
+  // its fix under canopy comes back with an unrelated error) instead of continuing where it was.
+  bool redraw_after_blackout = false;
   double rate = 1.0;                      // Hz, fixes per second
   double reported_std = 3.0;    // m, std written into the fix's covariance (what a phone would report)
   double antenna_height = 1.0;  // m above the map plane (altitude = datum altitude + this)

@@ -22,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace picker_localisation {
@@ -58,6 +59,15 @@ class LaneLayout {
   double lane_spacing_ = 1.5;
 };
 
+// Which lanes a picker's tour walks and how:
+//  serpentine    every lane in turn, alternating direction (the paper's walk, Sec. VI);
+//  skip_one      every other lane (lanes 0, 2, 4 ... of the order from the start lane), alternating
+//                direction: a picker whose neighbour works the lanes between;
+//  out_and_back  every lane in turn, walked to its far end and back by the same lane to its entry end.
+enum class LaneOrder { kSerpentine, kSkipOne, kOutAndBack };
+LaneOrder parseLaneOrder(const std::string& name);  // throws std::invalid_argument naming the choices
+const char* toString(LaneOrder order);
+
 // A closed walking tour over the map as a node sequence where consecutive nodes are adjacent in the motion
 // graph (the tour returns from its last node to its first through the graph as well).
 //  - Map with lanes: the serpentine of the paper (Sec. VI). Starting with lanes()[start], the picker walks
@@ -71,7 +81,8 @@ class LaneLayout {
 // the tour would have fewer than two nodes.
 std::vector<topology::NodeIndex> buildLaneTour(
     const topology::TopologicalMap& map, const LaneLayout& layout, std::size_t start_lane,
-    const std::vector<topology::NodeIndex>& fallback_waypoints = {});
+    const std::vector<topology::NodeIndex>& fallback_waypoints = {},
+    LaneOrder order = LaneOrder::kSerpentine);
 
 }  // namespace sim
 }  // namespace picker_localisation

@@ -8,7 +8,7 @@
 //    [speed_min, speed_max] (rejection sampling) when the picker is created, and drawn again each time it
 //    enters a new lane (pickers keep a pace inside a lane, change it between lanes).
 //  - Optional dwell (picking): on arriving at a lane node the picker stops for Exp(mean dwell_mean) s
-//    (dwell_mean = 0 disables it; the default).
+//    (dwell_mean = 0 disables it; the default), and with long_stop_probability for Exp(long_stop_mean) s.
 //  - Reversal ("at any step, p_change chance of changing direction for t_reverse seconds"): a "step" is a
 //    reversal decision taken every `reverse_step` seconds of forward walking (default 60 s = t_reverse). At
 //    each decision the picker turns round with probability p_reverse, walks its tour backwards for t_reverse
@@ -19,6 +19,7 @@
 //    decision per t_reverse keeps the pickers reversed ~9 % of the time and moving through the lanes.
 #pragma once
 
+#include "picker_localisation/sim/lane_layout.h"
 #include "picker_localisation/sim/sim_types.h"
 #include "picker_localisation/topology/topological_map.h"
 
@@ -38,6 +39,12 @@ struct PickerMotionParams {
   double reverse_step = 60.0;    // s of forward walking between reversal decisions (0: at every node arrival)
   double t_reverse = 60.0;       // s walked backwards after turning round (Table I t_reverse)
   double dwell_mean = 0.0;       // s, mean of the exponential stop at each lane node (0: no stops)
+  // Long stops (a picker packing trays, talking, on a break): at each lane node, with this probability, a
+  // stop of Exp(mean long_stop_mean) s. 0: none.
+  double long_stop_probability = 0.0;
+  double long_stop_mean = 180.0;  // s
+  // Which lanes the tour walks, in which order (lane_layout.h).
+  LaneOrder lane_order = LaneOrder::kSerpentine;
   double leg_radius = 0.06;      // m, leg circle radius (for the laser ray cast)
   double leg_spread = 0.2;       // m between the two legs' centres, across the heading
   double stride_length = 0.6;    // m travelled per full gait cycle (two steps)

@@ -70,8 +70,9 @@ namespace tpf {
 
 // One particle (Sec. IV: p = <q, v, tau, T, V>; T and V are shared by the filter), plus the lane-change path
 // index, the last lane change completed (TpfParams::lane_change_keep_side) and the GNSS bias state
-// (TpfParams::gnss_bias_state): 36 bytes. Single precision is ample for speeds
-// (m/s), dwell times (s) and biases (m) and halves the memory traffic of resampling.
+// (TpfParams::gnss_bias_state) and that bias's recent path (TpfParams::lane_swap_memory): 48 bytes. Single
+// precision is ample for speeds (m/s), dwell times (s) and biases (m) and halves the memory traffic of
+// resampling.
 struct Particle {
   topology::NodeIndex node = topology::kInvalidNode;  // q
   float vx = 0.0f, vy = 0.0f;                         // v, m/s, map frame
@@ -80,6 +81,10 @@ struct Particle {
   std::uint32_t last_lane_change = 0;  // 1 + index of the last lane-change path completed (0: none yet)
   float bias_x = 0.0f, bias_y = 0.0f;  // GNSS device bias b given this particle's path, m, map frame
   float bias_variance = -1.0f;         // per-axis variance of b, m^2; < 0: not started (next GNSS prior)
+  // Evidence of the bias path for lane swaps (TpfParams::lane_swap_memory): the integral of (b - m) dt and of
+  // dt over the recent fixes, each forgotten with the memory's time constant.
+  float bias_integral_x = 0.0f, bias_integral_y = 0.0f;  // m s
+  float bias_time = 0.0f;                                // s
 };
 
 enum class UpdateStatus {
@@ -198,6 +203,9 @@ class TopologicalParticleFilter {
   // per-particle Kalman update of b. Only for observations with usesBiasState(sensor), a position and a
   // prior.
   void weighWithBiasState(const core::Observation& obs);
+  // Lane hypotheses kept alive after resampling on a GNSS fix with the bias state
+  // (TpfParams::lane_swap_rate).
+  void swapLanes(const core::Observation& obs);
   void resample(double total_weight);
   void addNoise();
   void recordBelief(bool counted);
@@ -221,7 +229,8 @@ class TopologicalParticleFilter {
 
   double unconnected_p_ = 0.0;      // p_rj
   double bias_stamp_ = 0.0;         // s, stamp the particles' bias variances were last predicted to
-  double bias_variance_cap_ = 0.0;  // m^2, widest per-axis bias prior seen (cap of the random walk)
+  double bias_step_ = 0.0;          // s, time since the previous fix with the bias state (0 at the first)
+  double other_sensor_stamp_ = 0.0;  // s, last observation of a sensor without the bias state (-inf: none)
   double bias_fix_variance_ = 1.0;  // m^2, R of the bias state's fix model (constructor)
   Belief belief_;
   FilterCounters counters_;

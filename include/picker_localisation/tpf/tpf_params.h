@@ -110,15 +110,34 @@ struct TpfParams {
   // where they lie, unless the bias is known (after a sighting the prior from gnss_ingest is tight). The
   // device model is gnss_ingest's (bias_offset_std, bias_drift_std, bias_drift_tau), carried by each fix: new
   // or redrawn particles start from its prior (core::Observation::bias_removed / bias_covariance: the
-  // estimate after a sighting, else the bias prior), and b is a random walk of the fix's bias_drift_rate, its
-  // variance capped at the widest prior seen. Only observations of gnss_bias_sensors that carry a position
-  // and a bias prior use it; others weigh with L as Eq. 8.
+  // estimate after a sighting, else the bias prior), and b is the Gauss-Markov process of that prior (mean
+  // bias_removed, stationary variance bias_covariance, initial rate bias_drift_rate): every fix keeps
+  // weighing the bias a lane implies against the device's known error size. Only observations of
+  // gnss_bias_sensors that carry a position and a bias prior use it; others weigh with L as Eq. 8.
   bool gnss_bias_state = true;
   std::vector<std::string> gnss_bias_sensors{"gnss"};
   // m, per-axis spread of a fix about the particle's node once b is removed, besides where the picker is
   // between nodes (added from the map: node spacing^2 / 12): white noise, the picker across the lane,
   // particle lag.
   double gnss_bias_fix_std = 1.0;
+  // Lane hypotheses kept alive (a Metropolis-Hastings move after resampling on fixes with the bias state; the
+  // resample-move of Gilks and Berzuini 2001). Where fixes cannot tell two lanes apart (lanes 1.5 m apart, a
+  // phone's bias 3 m), a particle in lane L with bias b explains every fix exactly as well as one in the
+  // adjacent lane with bias b + the lane offset; only the device prior prefers one. Resampling alone lets the
+  // particle counts of such near-equal hypotheses drift until one lane holds all particles, and nothing
+  // brings the others back (no edge crosses a lane): pickers were held one lane off for whole walks. So each
+  // particle in a lane proposes, at lane_swap_rate (1/s), to stand at the nearest node of the adjacent lane
+  // on one side (at most lane_swap_max_distance away, across the lane axis) with its bias shifted so that it
+  // predicts the same fixes, and the move is accepted with the ratio of the device prior's densities of the
+  // two biases. The counts per lane then follow the evidence instead of resampling noise. Swaps pause for
+  // lane_swap_memory after an observation of another sensor (a robot saw the picker): that lane evidence is
+  // not in the bias path the acceptance weighs. 0: off.
+  double lane_swap_rate = 0.1;
+  double lane_swap_max_distance = 3.5;  // m
+  // s, how long the bias path a swap is weighed on is remembered (exponential forgetting): the acceptance
+  // also carries the Gauss-Markov path density of the recent biases, so evidence gathered over minutes (a
+  // lane end, the farm's edge) is not undone by swaps that the current bias alone would allow.
+  double lane_swap_memory = 600.0;
   bool usesBiasState(const std::string& sensor) const;
 
   // --- Eq. 8, weighting ------------------------------------------------------------------------------------
