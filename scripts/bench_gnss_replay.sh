@@ -8,7 +8,9 @@
 # Environment: BUILD_DIR (default build), RATE (farm_sim rate factor, 10), REPLAY_RATE (5),
 #   SENSORS: gnss (default, as above) | lidar_rfid: the patrolling robot's lasers and RFID reader are simulated and
 #   recorded too, the replay runs leg_detector and rfid_ranging, gnss_ingest associates the people and learns the
-#   GNSS biases (issue "Find the lane"), and the runner scores khan_connected and rfid_lidar_gnss.
+#   GNSS biases, and the runner scores khan_connected and rfid_lidar_gnss.
+#   SIM_CONFIG: the simulator config the sensor switches are applied to (default config/sim.yaml; another farm's walks
+#   or GNSS errors, e.g. scripts/bench_lane_variants.sh's variants); the runner then reads the same file.
 set -eo pipefail
 cd "$(dirname "$0")/.."
 MAP="$(realpath "${1:?usage: bench_gnss_replay.sh MAP [DURATION] [SEED] [WORK_DIR]}")"
@@ -24,16 +26,19 @@ mkdir -p "$ROS_HOME"
 source "$BUILD_DIR/devel/setup.bash"
 # GNSS only: every other simulated sensor off (the pickers' walks and GNSS errors do not depend on them).
 SENSORS="${SENSORS:-gnss}"
+SIM_BASE="${SIM_CONFIG:-config/sim.yaml}"
+RUNNER_SIM=()
 REGEX="/tf|/tf_static|/pickers/[^/]+/(fix|ground_truth)"
 METHODS=raw_fix,khan_connected,gnss_tpf
 if [ "$SENSORS" = lidar_rfid ]; then
-  sed -e 's/^  uwb: true/  uwb: false/' -e 's/^  camera: true/  camera: false/' config/sim.yaml > "$WORK/sim_gnss_only.yaml"
+  sed -e 's/^  uwb: true/  uwb: false/' -e 's/^  camera: true/  camera: false/' "$SIM_BASE" > "$WORK/sim_gnss_only.yaml"
   REGEX="$REGEX|/robot_[0-9]+/(scan_front|scan_rear|rfid|ground_truth)"
   METHODS=khan_connected,rfid_lidar_gnss
 else
   sed -e 's/^  laser: true/  laser: false/' -e 's/^  rfid: true/  rfid: false/' -e 's/^  uwb: true/  uwb: false/' \
-      -e 's/^  camera: true/  camera: false/' config/sim.yaml > "$WORK/sim_gnss_only.yaml"
+      -e 's/^  camera: true/  camera: false/' "$SIM_BASE" > "$WORK/sim_gnss_only.yaml"
 fi
+if [ -n "$SIM_CONFIG" ]; then RUNNER_SIM=(--sim-config "$WORK/sim_gnss_only.yaml"); fi
 own_master() {  # log args...
   local log="$WORK/$1.log"; shift
   local port=$((20000 + RANDOM % 20000))
@@ -67,7 +72,7 @@ own_master replay picker_localisation replay.launch bag:="$WORK/gnss.bag" rate:=
   map_file:="$MAP" output_csv:="$WORK/graph_errors.csv"
 [ -s "$WORK/graph_errors.csv" ] || { echo "replay wrote no errors: $WORK/replay.log" >&2; exit 1; }
 "$BUILD_DIR/devel/lib/picker_localisation/experiment" --map "$MAP" --scenario multi --runs 1 --seed "$SEED" \
-  --duration "$DURATION" --methods "$METHODS" --out "$WORK/runner" > "$WORK/runner.log"
+  --duration "$DURATION" --methods "$METHODS" --out "$WORK/runner" "${RUNNER_SIM[@]}" > "$WORK/runner.log"
 python3 - "$WORK/graph_errors.csv" "$WORK/runner/summary.csv" "$MAP" "$DURATION" "$SEED" "$SENSORS" <<'EOF'
 import csv, json, math, sys
 graph, summary, map_file, duration, seed = sys.argv[1:6]

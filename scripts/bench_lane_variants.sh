@@ -5,7 +5,10 @@
 # picker more than 0.2 below its own raw fix's lane share. Seeded: a run repeats exactly.
 # Usage: scripts/bench_lane_variants.sh [RUNS=8] [DURATION=900] [WORK_DIR]
 # Environment: BUILD_DIR (default build), TPF_CONFIG (default config/tpf.yaml), METHODS (raw_fix,khan_connected,gnss_tpf),
-#   VARIANTS (space-separated names of the list below; default all).
+#   VARIANTS (space-separated names of the list below; default all),
+#   GRAPH_VARIANTS (space-separated names): these variants also go through the ROS graph, seed 1
+#   (scripts/bench_gnss_replay.sh: farm_sim recorded to a bag, replayed through gnss_ingest -> tpf_tracker ->
+#   evaluator; ~5 min wall each), reported per picker as graph_tpf against the runner's raw_fix and gnss_tpf of seed 1.
 # Variants (maps from scripts/make_polytunnel_map.py; sim configs are config/sim.yaml with these changes):
 #   farms:  two_tunnels  12 untagged lanes x 135 m, 1.5 m apart, two tunnels, rotated 23 deg
 #           narrow       8 tagged lanes x 60 m, 1.2 m apart
@@ -65,3 +68,18 @@ for v in $ALL; do
     --out "$WORK/$name" --jobs 2 > "$WORK/$name.log" 2>&1 || { echo "experiment failed: $WORK/$name.log" >&2; exit 1; }
 done
 python3 scripts/lane_share_report.py "$WORK" "$METHODS"
+[ -n "$GRAPH_VARIANTS" ] || exit 0
+for name in $GRAPH_VARIANTS; do
+  farm="${name%%_*}"
+  [ "$farm" = two ] && farm=two_tunnels
+  [ -f "$WORK/sim_$name.yaml" ] || { echo "unknown variant $name (run it in the runner first)" >&2; exit 1; }
+  SIM_CONFIG="$WORK/sim_$name.yaml" scripts/bench_gnss_replay.sh "$WORK/$farm.tmap2" "$DURATION" 1 \
+    "$WORK/graph_run_$name" > "$WORK/graph_run_$name.json"
+  for m in raw_fix gnss_tpf graph_tpf; do mkdir -p "$WORK/graph/$name/$m"; done
+  cp "$WORK/graph_run_$name/runner/raw_fix/run_0.csv" "$WORK/graph/$name/raw_fix/run_0.csv"
+  cp "$WORK/graph_run_$name/runner/gnss_tpf/run_0.csv" "$WORK/graph/$name/gnss_tpf/run_0.csv"
+  cp "$WORK/graph_run_$name/graph_errors.csv" "$WORK/graph/$name/graph_tpf/run_0.csv"
+done
+echo
+echo "Through the ROS graph (seed 1):"
+python3 scripts/lane_share_report.py "$WORK/graph" raw_fix,gnss_tpf,graph_tpf

@@ -1165,6 +1165,30 @@ TEST(TpfGnssBias, LaneSwapsKeepHypothesesTheFixesCannotTellApart) {
   EXPECT_GT(tight.first, 0.999);
 }
 
+TEST(TpfDecision, MapNodeByLaneFirst) {
+  // Observations split the static particles: lane 5 holds 0.6 of the mass over three nodes (0.2 each), lane 6
+  // holds 0.4 on one node. Eq. 10 literally names lane 6's node (the single heaviest); by lane first, lane 5,
+  // and within it the node the likelihood favours.
+  auto map = polytunnel();
+  const NodeIndex a = *map->index("r5_4"), b = *map->index("r5_5"), c = *map->index("r5_6"),
+                  d = *map->index("r6_5");
+  auto decide = [&](bool by_lane) {
+    TpfParams p = staticParams(20000);
+    p.map_node_by_lane = by_lane;
+    TopologicalParticleFilter f(map, p, 11);
+    EXPECT_TRUE(f.update(obsAt(0.0, {a, b, c, d}, {1.0, 1.0, 1.0, 1.0})).ok());  // a quarter at each
+    EXPECT_TRUE(f.update(obsAt(0.0, {a, b, c, d}, {0.2, 0.21, 0.19, 0.4})).ok());
+    EXPECT_NEAR(f.belief().massOf(d), 0.4, 0.02);
+    return f.belief().map_node;
+  };
+  EXPECT_EQ(decide(false), d);
+  EXPECT_EQ(decide(true), b);
+  // The shipped defaults decide by lane; the paper's and Khan's presets follow Eq. 10.
+  EXPECT_TRUE(TpfParams().map_node_by_lane);
+  EXPECT_FALSE(TpfParams::presetForMethod("paper_tpf").map_node_by_lane);
+  EXPECT_FALSE(TpfParams::presetForMethod("khan_connected").map_node_by_lane);
+}
+
 TEST(TpfGnssBias, LaneSwapsPauseWhileARobotSeesThePicker) {
   // The same ambiguous fixes, but a UWB fix on lane 5 every 20 s (within lane_swap_memory): lane 5 keeps it.
   auto map = polytunnel();

@@ -311,12 +311,14 @@ void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::Topologic
       params_.gnss_bias_state && params_.lane_swap_rate > 0.0 ? params_.lane_swap_max_distance : 0.0);
   std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
   std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0), node_b(map->numNodes(), 0.0);
+  std::vector<double> lanes(map->numLanes(), 0.0);
   map_.swap(map);
   graph_.swap(graph);
   edge_scratch_.swap(edge);
   projection_scratch_.swap(projection);
   node_scratch_a_.swap(node_a);
   node_scratch_b_.swap(node_b);
+  lane_scratch_.swap(lanes);
   touched_.clear();
   // GNSS bias state: a fix spreads about the particle's node by gnss_bias_fix_std plus where the picker is
   // between nodes (uniform over the node spacing: variance spacing^2 / 12), from the map, not tuned to one.
@@ -862,6 +864,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     }
     mass[touched_[k]] = 0.0;
   }
+  if (params_.map_node_by_lane) chooseMapNodeByLane();
 
   resample(total);  // Eq. 11
   if (bias_state) swapLanes(obs);
@@ -1071,8 +1074,45 @@ void TopologicalParticleFilter::recordBelief(bool counted) {
     }
     count[touched_[k]] = 0.0;
   }
+  if (params_.map_node_by_lane) chooseMapNodeByLane();
   belief_.entropy = h;
   belief_.particle_count = particles_.size();
+}
+
+void TopologicalParticleFilter::chooseMapNodeByLane() {
+  // TpfParams::map_node_by_lane: the lane of most mass, then its node of most mass; a node in no lane is a
+  // group of its own. Ties go to the lowest node index (as Eq. 10 here). O(support).
+  std::vector<double>& lane_mass = lane_scratch_;
+  if (lane_mass.empty() || belief_.nodes.empty()) return;
+  for (std::size_t k = 0; k < belief_.nodes.size(); ++k) {
+    const topology::LaneIndex lane = map_->lane(belief_.nodes[k]);
+    if (lane >= 0) lane_mass[static_cast<std::size_t>(lane)] += belief_.masses[k];
+  }
+  double best_group = -1.0;
+  topology::LaneIndex best_lane = topology::kNoLane;
+  NodeIndex best_node = belief_.map_node;
+  for (std::size_t k = 0; k < belief_.nodes.size(); ++k) {
+    const topology::LaneIndex lane = map_->lane(belief_.nodes[k]);
+    const double group = lane >= 0 ? lane_mass[static_cast<std::size_t>(lane)] : belief_.masses[k];
+    if (group > best_group) {
+      best_group = group;
+      best_lane = lane;
+      best_node = belief_.nodes[k];
+    }
+  }
+  if (best_lane >= 0) {
+    double best = -1.0;
+    for (std::size_t k = 0; k < belief_.nodes.size(); ++k)
+      if (map_->lane(belief_.nodes[k]) == best_lane && belief_.masses[k] > best) {
+        best = belief_.masses[k];
+        best_node = belief_.nodes[k];
+      }
+  }
+  for (NodeIndex n : belief_.nodes) {
+    const topology::LaneIndex lane = map_->lane(n);
+    if (lane >= 0) lane_mass[static_cast<std::size_t>(lane)] = 0.0;
+  }
+  belief_.map_node = best_node;
 }
 
 // ------------------------------------------------------------------------------------------- what-if ------

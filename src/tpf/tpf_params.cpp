@@ -186,6 +186,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "lane_swap_rate",
                                                 "lane_swap_max_distance",
                                                 "lane_swap_memory",
+                                                "map_node_by_lane",
                                                 "resampling",
                                                 "motion_model",
                                                 "sensor_gammas",
@@ -257,6 +258,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "lane_swap_rate", p.lane_swap_rate);
   read(node, "lane_swap_max_distance", p.lane_swap_max_distance);
   read(node, "lane_swap_memory", p.lane_swap_memory);
+  read(node, "map_node_by_lane", p.map_node_by_lane);
   if (node["method"]) {  // mode switches win
     try {
       p = presetForMethod(node["method"].as<std::string>(), p);
@@ -293,6 +295,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.reinit_fraction = 1.0;
     p.reinit_sensors.clear();
     p.gnss_bias_state = false;
+    p.map_node_by_lane = false;
     return p;
   }
   if (method == "khan_connected" || method == "khan_unconnected") {
@@ -304,6 +307,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.jsd_monitor = false;
     p.entropy_gate = false;
     p.gnss_bias_state = false;  // each fix independent, as in [1]
+    p.map_node_by_lane = false;  // Eq. 10 as written
     if (method == "khan_connected")
       p.unconnected_jump_probability = 0.0;
     else if (p.unconnected_jump_probability <= 0.0)

@@ -115,7 +115,8 @@ struct Belief {
   double stamp = 0.0;                      // s, stamp of the last update / prediction
   std::vector<topology::NodeIndex> nodes;  // support (nodes holding particles), ascending index
   std::vector<double> masses;              // normalised topological mass per node (Eq. 9), sums to 1
-  topology::NodeIndex map_node = topology::kInvalidNode;  // n* (Eq. 10); ties -> lowest index
+  // n* (Eq. 10; by lane first with TpfParams::map_node_by_lane); ties -> lowest index
+  topology::NodeIndex map_node = topology::kInvalidNode;
   double entropy = 0.0;        // H of the particles' node distribution, nats (Alg. 1 l. 12)
   double jsd = 0.0;            // JSD of the last observation vs the predicted particles, [0, 1]
   bool reinitialised = false;  // the last update re-initialised the particles
@@ -207,6 +208,7 @@ class TopologicalParticleFilter {
   // (TpfParams::lane_swap_rate).
   void swapLanes(const core::Observation& obs);
   void resample(double total_weight);
+  void chooseMapNodeByLane();  // TpfParams::map_node_by_lane
   void addNoise();
   void recordBelief(bool counted);
   void fuse(const core::Observation& obs, double dt, UpdateResult& result);
@@ -223,6 +225,7 @@ class TopologicalParticleFilter {
   // |N|-sized scratch, all zero between calls (touched entries are cleared after use).
   std::vector<double> node_scratch_a_, node_scratch_b_;
   std::vector<topology::NodeIndex> touched_;
+  std::vector<double> lane_scratch_;        // per lane, all zero between calls (chooseMapNodeByLane)
   std::vector<double> edge_scratch_;        // per-edge jump contributions of one particle (max degree)
   std::vector<double> projection_scratch_;  // per-edge projections b of one particle (max degree)
   std::vector<std::uint32_t> spare_bits_;   // per particle: random bits of the prediction draw used by Eq. 12

@@ -132,12 +132,18 @@ struct TpfParams {
   // two biases. The counts per lane then follow the evidence instead of resampling noise. Swaps pause for
   // lane_swap_memory after an observation of another sensor (a robot saw the picker): that lane evidence is
   // not in the bias path the acceptance weighs. 0: off.
-  double lane_swap_rate = 0.1;
+  double lane_swap_rate = 0.2;
   double lane_swap_max_distance = 3.5;  // m
   // s, how long the bias path a swap is weighed on is remembered (exponential forgetting): the acceptance
   // also carries the Gauss-Markov path density of the recent biases, so evidence gathered over minutes (a
   // lane end, the farm's edge) is not undone by swaps that the current bias alone would allow.
   double lane_swap_memory = 600.0;
+  // The decision (Eq. 10's n*, the tracker's current_node, a dispatch target) by lane first: the lane holding
+  // the most mass, then its node of most mass (a node in no lane competes on its own mass). Eq. 10 literally
+  // (false) takes the single node of most mass: where the belief is spread over a few lanes and many nodes
+  // along them (GNSS only), that node is a draw among near-equal ones and its lane changes with the particle
+  // noise, while the lanes' totals are stable.
+  bool map_node_by_lane = true;
   bool usesBiasState(const std::string& sensor) const;
 
   // --- Eq. 8, weighting ------------------------------------------------------------------------------------
