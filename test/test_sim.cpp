@@ -111,36 +111,13 @@ TEST(LaneLayout, RiseholmeMapsHaveOrderedLanes) {
   }
 }
 
-TEST(LaneTour, SerpentineOnPolytunnel) {
-  const auto map = polytunnel(6, 8);
-  LaneLayout layout(map);
-  const auto tour = buildLaneTour(map, layout, 0);
-  // Closed walk on the graph.
+// A tour is a closed walk on the graph: consecutive nodes (and the last and the first) are adjacent.
+void expectClosedWalk(const topology::TopologicalMap& map, const std::vector<NodeIndex>& tour) {
   for (std::size_t k = 0; k < tour.size(); ++k)
     EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()])) << k;
-  // Lanes in adjacency order, alternating direction: even lanes entry->far, odd lanes far->entry.
-  std::vector<int> lane_sequence;
-  for (NodeIndex n : tour) {
-    const int o = layout.orderOf(map.lane(n));
-    if (o >= 0 && (lane_sequence.empty() || lane_sequence.back() != o)) lane_sequence.push_back(o);
-  }
-  EXPECT_EQ(lane_sequence, (std::vector<int>{0, 1, 2, 3, 4, 5}));
-  for (const auto& lane : layout.lanes()) {
-    const int o = layout.orderOf(lane.lane);
-    std::vector<NodeIndex> seen;
-    for (NodeIndex n : tour)
-      if (map.lane(n) == lane.lane) seen.push_back(n);
-    std::vector<NodeIndex> expected = lane.nodes;
-    if (o % 2 == 1) std::reverse(expected.begin(), expected.end());
-    EXPECT_EQ(seen, expected) << "lane " << o;
-  }
-  // Starting elsewhere gives the same cycle rotated.
-  const auto tour2 = buildLaneTour(map, layout, 2);
-  EXPECT_EQ(map.lane(tour2.front()), layout.lanes()[2].lane);
-  EXPECT_EQ(tour2.front(), layout.lanes()[2].entry_end());
 }
 
-// The lane sequence of a tour: the layout order of each lane entered, and how often each lane node is passed.
+// The layout order of each lane a tour enters, in the order entered.
 std::vector<int> laneSequence(const topology::TopologicalMap& map, const LaneLayout& layout,
                               const std::vector<NodeIndex>& tour) {
   std::vector<int> sequence;
@@ -151,17 +128,43 @@ std::vector<int> laneSequence(const topology::TopologicalMap& map, const LaneLay
   return sequence;
 }
 
+// The tour's nodes that lie in `lane`, in tour order.
+std::vector<NodeIndex> nodesInLane(const topology::TopologicalMap& map, const std::vector<NodeIndex>& tour,
+                                   topology::LaneIndex lane) {
+  std::vector<NodeIndex> seen;
+  for (NodeIndex n : tour)
+    if (map.lane(n) == lane) seen.push_back(n);
+  return seen;
+}
+
+TEST(LaneTour, SerpentineOnPolytunnel) {
+  const auto map = polytunnel(6, 8);
+  LaneLayout layout(map);
+  const auto tour = buildLaneTour(map, layout, 0);
+  expectClosedWalk(map, tour);
+  // Lanes in adjacency order, alternating direction: even lanes entry->far, odd lanes far->entry.
+  EXPECT_EQ(laneSequence(map, layout, tour), (std::vector<int>{0, 1, 2, 3, 4, 5}));
+  for (const auto& lane : layout.lanes()) {
+    const int o = layout.orderOf(lane.lane);
+    std::vector<NodeIndex> expected = lane.nodes;
+    if (o % 2 == 1) std::reverse(expected.begin(), expected.end());
+    EXPECT_EQ(nodesInLane(map, tour, lane.lane), expected) << "lane " << o;
+  }
+  // Starting elsewhere gives the same cycle rotated.
+  const auto tour2 = buildLaneTour(map, layout, 2);
+  EXPECT_EQ(map.lane(tour2.front()), layout.lanes()[2].lane);
+  EXPECT_EQ(tour2.front(), layout.lanes()[2].entry_end());
+}
+
 TEST(LaneTour, SkipOneWalksEveryOtherLane) {
   const auto map = polytunnel(8, 8);
   LaneLayout layout(map);
   const auto tour = buildLaneTour(map, layout, 0, {}, LaneOrder::kSkipOne);
-  for (std::size_t k = 0; k < tour.size(); ++k)
-    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()])) << k;
+  expectClosedWalk(map, tour);
   // Lanes 0, 2, 4, 6 walked end to end in alternating directions; the others at most passed at an end.
   std::vector<int> walked;
   for (const auto& lane : layout.lanes()) {
-    std::size_t inside = 0;
-    for (NodeIndex n : tour) inside += map.lane(n) == lane.lane ? 1 : 0;
+    const std::size_t inside = nodesInLane(map, tour, lane.lane).size();
     if (inside == lane.nodes.size()) walked.push_back(layout.orderOf(lane.lane));
     EXPECT_TRUE(inside == lane.nodes.size() || inside < lane.nodes.size() / 2)
         << layout.orderOf(lane.lane) << ": " << inside;
@@ -180,16 +183,12 @@ TEST(LaneTour, OutAndBackReturnsByTheSameLane) {
   const auto map = polytunnel(4, 8);
   LaneLayout layout(map);
   const auto tour = buildLaneTour(map, layout, 0, {}, LaneOrder::kOutAndBack);
-  for (std::size_t k = 0; k < tour.size(); ++k)
-    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()])) << k;
+  expectClosedWalk(map, tour);
   EXPECT_EQ(laneSequence(map, layout, tour), (std::vector<int>{0, 1, 2, 3}));
   for (const auto& lane : layout.lanes()) {
-    std::vector<NodeIndex> seen;
-    for (NodeIndex n : tour)
-      if (map.lane(n) == lane.lane) seen.push_back(n);
     std::vector<NodeIndex> expected = lane.nodes;
     expected.insert(expected.end(), lane.nodes.rbegin() + 1, lane.nodes.rend());
-    EXPECT_EQ(seen, expected) << "lane " << layout.orderOf(lane.lane);
+    EXPECT_EQ(nodesInLane(map, tour, lane.lane), expected) << "lane " << layout.orderOf(lane.lane);
   }
   EXPECT_EQ(parseLaneOrder("out_and_back"), LaneOrder::kOutAndBack);
   EXPECT_STREQ(toString(LaneOrder::kSkipOne), "skip_one");
@@ -232,8 +231,7 @@ TEST(LaneTour, MapWithoutLanesUsesWaypoints) {
   EXPECT_THROW(buildLaneTour(map, layout, 0), std::invalid_argument);
   const auto tour = buildLaneTour(map, layout, 0, {0, 15, 3});
   ASSERT_GE(tour.size(), 2u);
-  for (std::size_t k = 0; k < tour.size(); ++k)
-    EXPECT_TRUE(map.connected(tour[k], tour[(k + 1) % tour.size()]));
+  expectClosedWalk(map, tour);
   EXPECT_EQ(tour.front(), 0u);
   EXPECT_NE(std::find(tour.begin(), tour.end(), 15u), tour.end());
 }

@@ -100,13 +100,21 @@ struct TopologicalParticleFilter::MotionGraph {
     return {-axis.y(), axis.x()};
   }
 
-  void buildAcrossLanes(const topology::TopologicalMap& map, double max_distance) {
-    across.assign(2 * map.numNodes(), topology::kInvalidNode);
+  // Calls visit(lane, its nodes, its unit normal) for every lane of at least two nodes. "Sides" of a lane are
+  // the two half-planes of its normal.
+  template <typename Visit>
+  static void forEachLane(const topology::TopologicalMap& map, Visit visit) {
     for (std::size_t l = 0; l < map.numLanes(); ++l) {
       const auto lane = static_cast<topology::LaneIndex>(l);
       const auto& nodes = map.laneNodes(lane);
-      if (nodes.size() < 2) continue;
-      const Eigen::Vector2d normal = laneNormal(map, nodes);
+      if (nodes.size() >= 2) visit(lane, nodes, laneNormal(map, nodes));
+    }
+  }
+
+  void buildAcrossLanes(const topology::TopologicalMap& map, double max_distance) {
+    across.assign(2 * map.numNodes(), topology::kInvalidNode);
+    forEachLane(map, [&](topology::LaneIndex lane, const std::vector<NodeIndex>& nodes,
+                         const Eigen::Vector2d& normal) {
       for (NodeIndex e : nodes) {
         const Eigen::Vector2d pe = map.position2d(e);
         double best[2] = {max_distance, max_distance};
@@ -119,7 +127,7 @@ struct TopologicalParticleFilter::MotionGraph {
           if (distance < best[s]) best[s] = distance, across[2 * e + s] = k;
         }
       }
-    }
+    });
   }
 
   void buildLaneChangePaths(const topology::TopologicalMap& map, bool directed, int max_hops) {
@@ -127,12 +135,8 @@ struct TopologicalParticleFilter::MotionGraph {
     std::vector<std::vector<std::uint32_t>> exits(n);
     std::vector<int> depth(n, -1);
     std::vector<NodeIndex> parent(n, topology::kInvalidNode), visited;
-    for (std::size_t l = 0; l < map.numLanes(); ++l) {
-      const auto lane = static_cast<topology::LaneIndex>(l);
-      const auto& nodes = map.laneNodes(lane);
-      if (nodes.size() < 2) continue;
-      // "Sides" are the two half-planes of the lane's normal.
-      const Eigen::Vector2d normal = laneNormal(map, nodes);
+    forEachLane(map, [&](topology::LaneIndex lane, const std::vector<NodeIndex>& nodes,
+                         const Eigen::Vector2d& normal) {
       for (NodeIndex e : nodes) {
         int in_lane = 0;
         for (NodeIndex k : map.motionNeighbours(e, directed)) in_lane += map.lane(k) == lane ? 1 : 0;
@@ -181,7 +185,7 @@ struct TopologicalParticleFilter::MotionGraph {
         }
         for (NodeIndex k : visited) depth[k] = -1;
       }
-    }
+    });
     exit_offsets.assign(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
       exit_offsets[i + 1] = exit_offsets[i] + static_cast<std::uint32_t>(exits[i].size());

@@ -56,6 +56,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -233,7 +234,8 @@ class TopologicalParticleFilter {
   double unconnected_p_ = 0.0;      // p_rj
   double bias_stamp_ = 0.0;         // s, stamp the particles' bias variances were last predicted to
   double bias_step_ = 0.0;          // s, time since the previous fix with the bias state (0 at the first)
-  double other_sensor_stamp_ = 0.0;  // s, last observation of a sensor without the bias state (-inf: none)
+  // s, last observation of a sensor without the bias state (-inf: none)
+  double other_sensor_stamp_ = -std::numeric_limits<double>::infinity();
   double bias_fix_variance_ = 1.0;  // m^2, R of the bias state's fix model (constructor)
   Belief belief_;
   FilterCounters counters_;
