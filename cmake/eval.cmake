@@ -8,33 +8,11 @@ target_link_libraries(picker_localisation_eval PUBLIC picker_localisation_core o
   opencv_imgcodecs)
 target_include_directories(picker_localisation_eval SYSTEM PUBLIC ${OpenCV_INCLUDE_DIRS})
 
-# The experiment runner uses the other areas' core libraries that exist in this build; a method needing a
-# missing one is reported unavailable at run time (PL_HAVE_<X> tells the source what is there).
+# The experiment runner drives the nodes' own core classes (simulator, front-ends, tracker fleet, planner).
 add_library(picker_localisation_experiment src/eval/experiment.cpp)
-target_link_libraries(picker_localisation_experiment PUBLIC picker_localisation_eval)
+target_link_libraries(picker_localisation_experiment PUBLIC picker_localisation_eval picker_localisation_sim
+  picker_localisation_tpf picker_localisation_vision picker_localisation_sensors_ranging picker_localisation_nbs)
 target_compile_definitions(picker_localisation_experiment PRIVATE PL_EVAL_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
-# Deferred to the end of the top-level file: the nbs area is included after this one.
-function(pl_eval_link_components)
-  set(have "")
-  foreach(pair "SIM:picker_localisation_sim" "TPF:picker_localisation_tpf" "VISION:picker_localisation_vision"
-               "RANGING:picker_localisation_sensors_ranging" "RANGING:picker_localisation_ranging"
-               "NBS:picker_localisation_nbs")
-    string(REPLACE ":" ";" pair_list "${pair}")
-    list(GET pair_list 0 flag)
-    list(GET pair_list 1 lib)
-    if(flag STREQUAL "NBS" AND (NOT "TPF" IN_LIST have
-       OR NOT EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/src/nbs/tpf_belief_source.cpp))
-      continue()
-    endif()
-    if(TARGET ${lib} AND NOT flag IN_LIST have)
-      list(APPEND have ${flag})
-      target_link_libraries(picker_localisation_experiment PUBLIC ${lib})
-      target_compile_definitions(picker_localisation_experiment PRIVATE PL_HAVE_${flag})
-    endif()
-  endforeach()
-  message(STATUS "eval: experiment runner built with: ${have}")
-endfunction()
-cmake_language(DEFER CALL pl_eval_link_components)
 
 add_executable(experiment src/tools/experiment.cpp)
 target_link_libraries(experiment picker_localisation_experiment)

@@ -1,10 +1,6 @@
 pl_add_gtest(test_eval_metrics test/test_eval_metrics.cpp LIBS picker_localisation_eval)
 pl_add_gtest(test_ukf_metric test/test_ukf_metric.cpp LIBS picker_localisation_eval)
 pl_add_gtest(test_experiment test/test_experiment.cpp LIBS picker_localisation_experiment)
-if(TARGET picker_localisation_sim)
-  target_link_libraries(test_experiment picker_localisation_sim)
-  target_compile_definitions(test_experiment PRIVATE PL_TEST_HAVE_SIM)
-endif()
 # The ROS graph against the offline runner on one seed (needs every node of the graph).
 if(TARGET farm_sim AND TARGET gnss_ingest AND TARGET rfid_ranging AND TARGET leg_detector AND TARGET tpf_tracker)
   add_rostest_gtest(test_eval_graph_vs_runner test/eval_graph_vs_runner.test test/test_eval_graph_vs_runner.cpp)

@@ -2,6 +2,7 @@
 # ROS-free core library (namespace picker_localisation::sensors).
 add_library(picker_localisation_sensors_ranging
   src/sensors_ranging/gnss_bias.cpp
+  src/sensors_ranging/gnss_fleet.cpp
   src/sensors_ranging/gnss_ingest.cpp
   src/sensors_ranging/picker_association.cpp
   src/sensors_ranging/rfid_observation_model.cpp

@@ -10,13 +10,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include "legacy_tmap.h"
+#include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/eval/experiment.h"
+#include "picker_localisation/sim/farm_simulator.h"
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
-#ifdef PL_TEST_HAVE_SIM
-#include "picker_localisation/core/picker_registry.h"
-#include "picker_localisation/sim/farm_simulator.h"
-#endif
 
 using namespace picker_localisation;
 using namespace picker_localisation::eval;
@@ -145,7 +143,6 @@ TEST(Experiment, UnavailableMethodIsReportedNotRun) {
   EXPECT_THROW(runExperiment(c, log), std::invalid_argument);
 }
 
-#ifdef PL_TEST_HAVE_SIM
 TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
   if (!methodUnavailableReason("khan_connected").empty())
     GTEST_SKIP() << methodUnavailableReason("khan_connected");
@@ -180,9 +177,7 @@ TEST(Experiment, LegacyMapAndTruthFromTheSimulator) {
   }
   EXPECT_GT(checked, 60u);  // 3 pickers, ~30 samples each (after the first fix)
 }
-#endif
 
-#ifdef PL_TEST_HAVE_SIM
 TEST(Experiment, RawFixIsTheNodeNearestTheLatestFix) {
   // With every GNSS error off but a 0.1 m white noise, the raw fix's node is within half a node spacing (~1.5 m)
   // of the truth most of the time: the baseline measures the fixes, not a filter.
@@ -242,7 +237,8 @@ TEST(Experiment, LidarPeopleTeachTheGnssBias) {
   }
   ASSERT_GT(fresh_lane, 20u);
   EXPECT_LT(fresh_residual / fresh, 1.0);  // m: the estimate is within a metre of the true error
-  if (never > 0) EXPECT_GT(never_residual / never, fresh_residual / fresh);
+  if (never > 0) {
+    EXPECT_GT(never_residual / never, fresh_residual / fresh);
+  }
   EXPECT_GT(static_cast<double>(fresh_right) / fresh_lane, 0.85);
 }
-#endif

@@ -23,27 +23,13 @@
 
 #include <yaml-cpp/yaml.h>
 
-// Components of other areas: each is compiled in only when its library is part of this build (the eval cmake
-// fragment defines PL_HAVE_<X> from the targets that exist), so a method needing a missing one is reported
-// unavailable instead of being faked.
-#ifdef PL_HAVE_SIM
-#include "picker_localisation/sim/farm_simulator.h"
-#endif
-#ifdef PL_HAVE_TPF
-#include "picker_localisation/tpf/topological_particle_filter.h"
-#endif
-#ifdef PL_HAVE_RANGING
-#include "picker_localisation/sensors_ranging/gnss_ingest.h"
-#include "picker_localisation/sensors_ranging/picker_association.h"
-#include "picker_localisation/sensors_ranging/rfid_observation_model.h"
-#endif
-#ifdef PL_HAVE_VISION
-#include "picker_localisation/sensors_vision/leg_pipeline.h"
-#endif
-#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 #include "picker_localisation/nbs/tpf_belief_source.h"
-#endif
+#include "picker_localisation/sensors_ranging/gnss_fleet.h"
+#include "picker_localisation/sensors_ranging/rfid_observation_model.h"
+#include "picker_localisation/sensors_vision/leg_pipeline.h"
+#include "picker_localisation/sim/farm_simulator.h"
+#include "picker_localisation/tpf/tracker_fleet.h"
 
 #ifndef PL_EVAL_PACKAGE_DIR
 #define PL_EVAL_PACKAGE_DIR "."
@@ -183,45 +169,15 @@ std::string methodUnavailableReason(const std::string& method, const RunConfig& 
   if (!isKnownMethod(method)) return "unknown method";
   const MethodSpec& spec = specOf(method);
   std::vector<std::string> missing;
-#ifndef PL_HAVE_SIM
-  missing.push_back("the farm simulator (library picker_localisation_sim)");
-#endif
-#ifndef PL_HAVE_RANGING
-  missing.push_back("GnssIngest / RfidObservationModel (sensors_ranging library)");
-#endif
-  if (spec.tracker == Tracker::kTpf) {
-#ifndef PL_HAVE_TPF
-    missing.push_back("the Topological Particle Filter (library picker_localisation_tpf)");
-#endif
-  }
-  if (spec.lidar) {
-#ifndef PL_HAVE_VISION
-    missing.push_back("the LegDetector (library picker_localisation_vision)");
-#else
-    if (!fs::exists(legModelPath(config)))
-      missing.push_back("the leg classifier model " + legModelPath(config));
-#endif
-  }
-  if (spec.policy != RobotPolicy::kPatrol) {
-#ifndef PL_HAVE_NBS
-    missing.push_back("the Next-Best-Sense planner with TpfBeliefSource (library picker_localisation_nbs)");
-#endif
-  }
+  if (spec.lidar && !fs::exists(legModelPath(config)))
+    missing.push_back("the leg classifier model " + legModelPath(config));
   if (missing.empty()) return "";
   std::string reason = "needs ";
   for (std::size_t i = 0; i < missing.size(); ++i) reason += (i ? ", " : "") + missing[i];
   return reason;
 }
 
-#if defined(PL_HAVE_SIM) && defined(PL_HAVE_RANGING)
 namespace {
-
-// One raw measurement of the simulator, for merging the sensor streams into stamp order.
-struct Event {
-  double stamp;
-  int kind;  // 0 gnss, 1 rfid, 2 laser (tie order)
-  std::size_t index;
-};
 
 // The front-ends' options: the same files and the same schema as the gnss_ingest / rfid_ranging nodes.
 sensors::GnssIngestOptions gnssOptions(const std::string& file) {
@@ -231,31 +187,11 @@ sensors::RfidModelOptions rfidOptions(const std::string& file) {
   return file.empty() ? sensors::RfidModelOptions() : sensors::RfidModelOptions::fromYamlFile(file);
 }
 
-// The per-picker tracker of a run: a TPF or the picker's view of the shared UKF.
-struct PickerTrack {
-  std::string id;
-#ifdef PL_HAVE_TPF
-  std::unique_ptr<tpf::TopologicalParticleFilter> tpf;
-#endif
-  std::unique_ptr<sensors::GnssIngest> gnss;
-  NodeIndex raw_fix_node = topology::kInvalidNode;  // raw_fix: the node nearest the latest accepted fix
-  Eigen::Vector2d true_gnss_error{std::nan(""), std::nan("")};  // scoring only: the simulator's error of the
-                                                               // latest fix (never reaches an estimator)
-  // Scoring the "lane right within 30 s of a sighting after the first fix or a blackout" criterion.
-  double restart = std::nan("");             // stamp of the first fix, or of the fix that ended a blackout
-  double seen_after_restart = std::nan("");  // first accepted bias sighting after it
-};
-
-}  // namespace
-
-RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config) {
-  const std::string why = methodUnavailableReason(config.method, config);
-  if (!why.empty()) throw std::runtime_error("method " + config.method + " unavailable: " + why);
-  const auto wall0 = std::chrono::steady_clock::now();
-  const MethodSpec& spec = specOf(config.method);
-  RunResult result;
-
-  // --- simulator: the ROS graph's configuration files, then the scenario --------------------------------
+// The simulator of a run: the ROS graph's configuration files, then the scenario's pickers, one robot
+// patrolling the lanes and only the sensors the method uses (the simulator guarantees that switching a sensor
+// off changes neither the pickers' walks nor their GNSS errors, so every method of a seed sees the same
+// pickers).
+sim::SimConfig simConfigFor(const RunConfig& config, const MethodSpec& spec) {
   const std::string sim_file = resolveConfigFile(config.sim_config, "sim.yaml");
   const std::string datum_file = resolveConfigFile(config.datum_file, "datum.yaml");
   const std::string pickers_file = resolveConfigFile(config.pickers_file, "pickers.yaml");
@@ -282,90 +218,106 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
   sc.num_robots = 1;
   sc.robot_ids.clear();
   sc.robot_motion.patrol = sim::PatrolPolicy::kLanes;
-  // Sensors a method does not use are switched off (the simulator guarantees that this does not change the
-  // pickers' walks or GNSS errors, so every method of a seed sees the same pickers).
   sc.enable.gnss = spec.gnss;
   sc.enable.laser = spec.lidar;
   sc.enable.rfid = spec.rfid;
   sc.enable.uwb = false;
   sc.enable.camera = false;
-  sim::FarmSimulator simulator(*map, sc);
+  return sc;
+}
 
-  // --- front-ends (GnssIngest: the simulator's datum, from the datum file as gnss_ingest reads it) ------------
-  const core::GeodeticDatum& datum = simulator.datum();
-  const sensors::GnssIngestOptions gnss_options =
-      gnssOptions(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"));
-  std::vector<PickerTrack> tracks(n);
+// One run's graph: the nodes' own core classes, wired as the ROS graph wires the nodes. gnss_ingest is a
+// sensors::GnssFleet, rfid_ranging an RfidObservationModel, leg_detector a LegPipeline, tpf_tracker a
+// tpf::TrackerFleet, nbs_planner a NextBestSensePlanner; publish() is the /observations topic (every tracker
+// and gnss_ingest's identifying-observation input), the tracker fleet's belief listener the beliefs topic
+// gnss_ingest follows. Only the scoring (ground truth) is the runner's own.
+class GraphRun {
+ public:
+  GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config);
+  sim::FarmSimulator& simulator() { return simulator_; }
+  void onFix(const sim::GnssFixWithTruth& fix);
+  void onRfid(const sim::RfidReadingWithTruth& read);
+  void onScan(const sim::LaserScanWithTruth& scan);
+  // The trackers' periodic predictions and the planner, at the end of a simulator step.
+  void endOfStep(double now);
+  // One error sample per picker with an estimate (scoring).
+  void sample(double t);
+  RunResult& result() { return result_; }
+
+ private:
+  // What a picker's run is scored on; never reaches an estimator.
+  struct Scoring {
+    std::string id;
+    NodeIndex raw_fix_node = topology::kInvalidNode;  // raw_fix: the node nearest the latest accepted fix
+    Eigen::Vector2d true_gnss_error{std::nan(""), std::nan("")};  // the simulator's error of the latest fix
+    // "Lane right within 30 s of a sighting after the first fix or a blackout".
+    double restart = std::nan("");             // stamp of the first fix, or of the fix that ended a blackout
+    double seen_after_restart = std::nan("");  // first accepted bias sighting after it
+  };
+  void publish(const core::Observation& obs);
+  NodeIndex estimate(std::size_t picker) const;
+
+  std::shared_ptr<const topology::TopologicalMap> map_;
+  RunConfig config_;
+  const MethodSpec& spec_;
+  sim::FarmSimulator simulator_;
+  std::vector<Scoring> scoring_;
+  std::unique_ptr<sensors::GnssFleet> gnss_;
+  std::unique_ptr<sensors::RfidObservationModel> rfid_;
+  std::unique_ptr<vision::LegPipeline> legs_;
+  std::unique_ptr<tpf::TrackerFleet> trackers_;  // Tracker::kTpf
+  UkfMetricTracker ukf_;                         // Tracker::kUkf
+  std::unique_ptr<nbs::NextBestSensePlanner> planner_;
+  std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources_;
+  double replan_period_ = 0.0, battery_level_ = 1.0, last_plan_ = -1e300;
+  RunResult result_;
+};
+
+GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config)
+    : map_(std::move(map)),
+      config_(config),
+      spec_(specOf(config.method)),
+      simulator_(*map_, simConfigFor(config, spec_)),
+      replan_period_(config.replan_period) {
+  const std::size_t n = simulator_.numPickers();
   std::vector<core::PickerConfig> registry_entries;
+  gnss_ = std::make_unique<sensors::GnssFleet>(
+      map_, simulator_.datum(), gnssOptions(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml")));
   for (std::size_t i = 0; i < n; ++i) {
-    const sim::PickerSpec& ps = simulator.pickerSpec(i);
-    tracks[i].id = ps.id;
-    tracks[i].gnss = std::make_unique<sensors::GnssIngest>(ps.id, map, datum, gnss_options);
+    const sim::PickerSpec& ps = simulator_.pickerSpec(i);
+    scoring_.push_back({ps.id});
+    gnss_->add(ps.id);
     registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag, ""});
   }
-  const core::PickerRegistry registry(registry_entries);
-  // What gnss_ingest keeps of the trackers' published beliefs (the association reads them with a lag).
-  std::vector<sensors::BeliefHistory> belief_history(n);
-  sensors::IdentityEvidence identity_evidence;  // gnss_ingest's: RFID reads and failed reads per picker
-  std::vector<sensors::GnssIngest*> ingests;
-  for (auto& t : tracks) ingests.push_back(t.gnss.get());
-  sensors::RfidObservationModel rfid_model(
-      registry, map, rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
-#ifdef PL_HAVE_VISION
-  // The leg_detector node's pipeline, from the same files and keys (one per robot: per-laser trackers).
-  std::unique_ptr<vision::LegPipeline> legs;
-  if (spec.lidar) {
+  rfid_ = std::make_unique<sensors::RfidObservationModel>(
+      core::PickerRegistry(registry_entries), map_,
+      rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
+  if (spec_.lidar) {  // the leg_detector node's pipeline, from the same files and keys
     auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(legModelPath(config));
-    legs = std::make_unique<vision::LegPipeline>(
+    legs_ = std::make_unique<vision::LegPipeline>(
         classifier, vision::LegPipelineOptions::fromYamlFiles(visionConfigFiles(config.vision_config)));
   }
-#endif
-
-  // --- trackers ----------------------------------------------------------------------------------------
-  UkfMetricTracker ukf;
-#ifdef PL_HAVE_TPF
-  double prediction_period = 4.0;
-  if (spec.tracker == Tracker::kTpf) {
+  if (spec_.tracker == Tracker::kTpf) {
     const std::string tpf_file = resolveConfigFile(config.tpf_config, "tpf.yaml");
-    tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
-    const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec.tpf_preset, base);
-    prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 1e300;
-    for (std::size_t i = 0; i < n; ++i)
-      tracks[i].tpf = std::make_unique<tpf::TopologicalParticleFilter>(
-          map, params, sim::deriveSeed(config.tracker_seed ? config.tracker_seed : config.seed, 1000 + i));
-  }
-#endif
-  auto publishBelief = [&](const PickerTrack& t) {
-#ifdef PL_HAVE_TPF
-    if (!t.tpf->initialised()) return;
-    const tpf::Belief& b = t.tpf->belief();
-    belief_history[static_cast<std::size_t>(&t - tracks.data())].push(b.stamp, b.nodes, b.masses);
-#else
-    (void)t;
-#endif
-  };
-  auto toTracker = [&](const core::Observation& obs) {
-#ifdef PL_HAVE_TPF
-    for (auto& t : tracks) {
-      if (!core::concernsPicker(obs, t.id)) continue;
-      if (t.tpf) {
-        t.tpf->update(obs);
-        ++result.observations;
-        publishBelief(t);
-      }
+    const tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
+    const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec_.tpf_preset, base);
+    trackers_ = std::make_unique<tpf::TrackerFleet>(map_, [this](tpf::TrackerFleet::Track& t) {
+      const tpf::Belief& b = t.filter->belief();
+      if (b.initialised) gnss_->addBelief(t.id, b.stamp, b.nodes, b.masses);
+    });
+    for (std::size_t i = 0; i < n; ++i) {
+      std::string error;
+      // A run's filters are seeded from the run's seed; with tracker_seed as tpf_tracker with ~seed seeds
+      // them.
+      const std::uint64_t seed = config.tracker_seed
+                                     ? tpf::TrackerFleet::seedFor(scoring_[i].id, config.tracker_seed)
+                                     : sim::deriveSeed(config.seed, 1000 + i);
+      if (!trackers_->add(scoring_[i].id, params, seed, &error))
+        throw std::runtime_error("tracker of " + scoring_[i].id + ": " + error);
     }
-#else
-    (void)obs;
-#endif
-  };
-
-  // --- navigation policy -------------------------------------------------------------------------------
-#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
-  std::unique_ptr<nbs::NextBestSensePlanner> planner;
-  std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources;
-  double replan_period = config.replan_period, battery_level = 1.0;
-  if (spec.policy != RobotPolicy::kPatrol) {
+  }
+  if (spec_.policy != RobotPolicy::kPatrol) {
     // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
     // what_if_seed); the method sets the policy.
     const std::string nbs_file = resolveConfigFile(config.nbs_config, "nbs.yaml");
@@ -374,24 +326,175 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     std::uint64_t what_if_seed = 1;
     if (!nbs_file.empty()) {
       const YAML::Node y = YAML::LoadFile(nbs_file);
-      core::readOption(y, nbs_file, "planning_period", replan_period);
-      core::readOption(y, nbs_file, "battery_level", battery_level);
+      core::readOption(y, nbs_file, "planning_period", replan_period_);
+      core::readOption(y, nbs_file, "battery_level", battery_level_);
       core::readOption(y, nbs_file, "what_if_seed", what_if_seed);
     }
-    pc.policy = spec.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
-    planner = std::make_unique<nbs::NextBestSensePlanner>(map, pc);
-    for (auto& t : tracks)
-      sources.push_back(
-          std::make_unique<nbs::TpfBeliefSource>(t.id, *t.tpf, what_if_seed ? what_if_seed : 1));
+    pc.policy = spec_.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
+    planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, pc);
+    for (const auto& s : scoring_)
+      sources_.push_back(std::make_unique<nbs::TpfBeliefSource>(s.id, *trackers_->find(s.id)->filter,
+                                                                what_if_seed ? what_if_seed : 1));
   }
-  double last_plan = -1e300;
-#endif
+}
 
-  // --- main loop ---------------------------------------------------------------------------------------
+void GraphRun::publish(const core::Observation& obs) {
+  if (trackers_) result_.observations += trackers_->process(obs).size();
+  gnss_->useIdentified(obs);
+}
+
+void GraphRun::onFix(const sim::GnssFixWithTruth& f) {
+  Scoring& s = scoring_.at(f.picker_index);
+  if (f.error.allFinite()) s.true_gnss_error = f.error;
+  sensors::GnssFleet::Picker& picker = *gnss_->find(s.id);
+  const sensors::GnssResult r = gnss_->processFix(picker, f);
+  if (!r.accepted()) return;
+  if (picker.ingest.counters().accepted == 1 || r.blackout_ended > 0.0) {
+    s.restart = f.stamp;
+    s.seen_after_restart = std::nan("");
+  }
+  if (spec_.tracker == Tracker::kRawFix)
+    s.raw_fix_node = map_->nearestNode(r.position);
+  else if (spec_.tracker == Tracker::kUkf)
+    ukf_.addGnss(f.stamp, s.id, *r.observation->position, r.observation->position_covariance);
+  else
+    publish(*r.observation);
+}
+
+void GraphRun::onRfid(const sim::RfidReadingWithTruth& rr) {
+  sensors::RfidRead read;
+  static_cast<core::RfidReading&>(read) = rr;
+  sim::Pose2D mount;  // the antenna pose the node gets from tf: the simulator's (ground truth)
+  for (const auto& m : simulator_.config().sensor_layout.rfid_antennas)
+    if (m.frame == rr.mount) mount = m.pose;
+  const sim::Pose2D antenna = simulator_.robotPose(rr.robot_index).compose(mount);
+  read.antenna_pose = Eigen::Vector3d(antenna.x, antenna.y, antenna.yaw);
+  const sensors::RfidResult r = rfid_->process(read);
+  if (r.observation) {
+    const std::size_t before = gnss_->counters().sightings;
+    publish(*r.observation);
+    result_.bias_sightings += gnss_->counters().sightings - before;
+  }
+  for (const auto& neg : r.negative) publish(neg);
+}
+
+void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
+  // The sensor pose the node gets from tf, here the simulator's (ground truth) laser pose.
+  const Eigen::Isometry3d fixed_from_sensor = Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
+                                              Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
+  const std::vector<vision::PersonCandidate> candidates = legs_->scanCandidates(s, fixed_from_sensor);
+  const std::vector<vision::TrackedPerson> tracked = legs_->track(s.frame_id, s.stamp, candidates);
+  if (spec_.tracker != Tracker::kUkf)  // as leg_detector publishes it: "nobody at these nodes"
+    if (auto neg = legs_->negativeObservation(s.frame_id, s.stamp, s, fixed_from_sensor, candidates, *map_,
+                                              s.robot_id))
+      publish(*neg);
+  result_.lidar_detections += tracked.size();
+  std::vector<Eigen::Vector2d> people;
+  for (const auto& t : tracked) {
+    // Identity for the anonymous people, as gnss_ingest gives it.
+    const sensors::AssociationResult a =
+        gnss_->associate(vision::LegPipeline::observation(t, *map_, s.stamp, s.robot_id));
+    if (a.picker >= 0) {
+      ++result_.identified_detections;
+      std::size_t nearest = 0;
+      double best = 1e300;
+      for (std::size_t j = 0; j < scoring_.size(); ++j) {
+        const double d = (simulator_.pickerPose(j).position() - t.position).norm();
+        if (d < best) best = d, nearest = j;
+      }
+      if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) ++result_.wrong_identifications;
+    }
+    if (a.bias.accepted) {
+      ++result_.bias_sightings;
+      Scoring& seen = scoring_[static_cast<std::size_t>(a.picker)];
+      if (!std::isnan(seen.restart) && std::isnan(seen.seen_after_restart)) seen.seen_after_restart = s.stamp;
+    }
+    if (a.concerns_nobody) continue;  // nobody we track (clutter under the association)
+    if (spec_.tracker != Tracker::kUkf)
+      publish(a.observation);
+    else if (a.picker >= 0)
+      ukf_.addGnss(s.stamp, a.observation.picker_id, t.position, a.observation.position_covariance);
+    else
+      people.push_back(t.position);
+  }
+  if (!people.empty()) ukf_.addDetections(s.stamp, people);
+}
+
+void GraphRun::endOfStep(double now) {
+  if (trackers_) trackers_->predictDue(now);
+  if (!planner_ || !(simulator_.robot(0).atGoal() || now - last_plan_ >= replan_period_)) return;
+  std::vector<nbs::BeliefSource*> views;
+  for (std::size_t i = 0; i < sources_.size(); ++i) {
+    // The bias covariance gnss_ingest publishes (GnssBias.covariance), as the nbs_planner node reads it.
+    sources_[i]->setBiasCovariance(gnss_->find(scoring_[i].id)->ingest.bias().appliedCovariance(now));
+    views.push_back(sources_[i].get());
+  }
+  const nbs::PlanResult plan = planner_->plan(simulator_.robot(0).currentNode(), battery_level_, views);
+  if (plan.ok()) simulator_.setRobotGoal(0, plan.ranked.front().node);
+  last_plan_ = now;
+}
+
+NodeIndex GraphRun::estimate(std::size_t i) const {
+  switch (spec_.tracker) {
+    case Tracker::kTpf: {
+      const tpf::TopologicalParticleFilter& f = *trackers_->tracks().at(scoring_[i].id)->filter;
+      return f.initialised() ? f.belief().map_node : topology::kInvalidNode;
+    }
+    case Tracker::kUkf: {
+      const auto p = ukf_.estimate(scoring_[i].id);
+      return p ? map_->nearestNode(*p) : topology::kInvalidNode;
+    }
+    case Tracker::kRawFix:
+      return scoring_[i].raw_fix_node;
+  }
+  return topology::kInvalidNode;
+}
+
+void GraphRun::sample(double t) {
+  for (std::size_t i = 0; i < scoring_.size(); ++i) {
+    const NodeIndex est = estimate(i);
+    if (est == topology::kInvalidNode) continue;  // no estimate yet (before the first observation)
+    Scoring& s = scoring_[i];
+    result_.samples.push_back(computeError(*map_, est, simulator_.pickerPose(i).position(), t, s.id));
+    const ErrorSample& e = result_.samples.back();
+    if (s.true_gnss_error.allFinite()) {
+      const sensors::GnssBiasEstimator& b = gnss_->find(s.id)->ingest.bias();
+      BiasSample bs;
+      bs.sighting_age = b.sighted() ? t - b.lastSighting() : std::numeric_limits<double>::infinity();
+      bs.residual = (s.true_gnss_error - b.applied(t)).norm();
+      bs.lane_applicable = e.lane_applicable;
+      bs.in_true_lane = e.in_true_lane;
+      result_.bias_samples.push_back(bs);
+    }
+    if (!std::isnan(s.seen_after_restart)) {
+      const double since = t - s.seen_after_restart;
+      const bool right = e.lane_applicable && e.in_true_lane;
+      if (right || since > 120.0) {
+        result_.lane_delays.push_back(right ? since : std::numeric_limits<double>::infinity());
+        s.restart = s.seen_after_restart = std::nan("");
+      }
+    }
+  }
+}
+
+}  // namespace
+
+RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const RunConfig& config) {
+  const std::string why = methodUnavailableReason(config.method, config);
+  if (!why.empty()) throw std::runtime_error("method " + config.method + " unavailable: " + why);
+  const auto wall0 = std::chrono::steady_clock::now();
+  GraphRun run(std::move(map), config);
+  sim::FarmSimulator& simulator = run.simulator();
+  // One raw measurement of the simulator; the streams are merged into stamp order (ties: gnss, rfid, laser).
+  struct Event {
+    double stamp;
+    int kind;
+    std::size_t index;
+  };
   double next_sample = config.sample_period;
   while (simulator.time() < config.duration - 1e-9) {
-    const double t_next = std::min(config.duration, simulator.time() + config.step);
-    sim::SimOutputs out = simulator.advanceTo(t_next);
+    const sim::SimOutputs out =
+        simulator.advanceTo(std::min(config.duration, simulator.time() + config.step));
     std::vector<Event> events;
     for (std::size_t k = 0; k < out.gnss.size(); ++k) events.push_back({out.gnss[k].stamp, 0, k});
     for (std::size_t k = 0; k < out.rfid.size(); ++k) events.push_back({out.rfid[k].stamp, 1, k});
@@ -400,168 +503,18 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
       return a.stamp != b.stamp ? a.stamp < b.stamp : a.kind < b.kind;
     });
     for (const Event& e : events) {
-      if (e.kind == 0) {
-        const sim::GnssFixWithTruth& f = out.gnss[e.index];
-        PickerTrack& t = tracks.at(f.picker_index);
-        if (f.error.allFinite()) t.true_gnss_error = f.error;
-        const sensors::GnssResult r = t.gnss->process(f);
-        if (!r.accepted()) continue;
-        if (t.gnss->counters().accepted == 1 || r.blackout_ended > 0.0) {
-          t.restart = f.stamp;
-          t.seen_after_restart = std::nan("");
-        }
-        if (spec.tracker == Tracker::kRawFix) {
-          t.raw_fix_node = map->nearestNode(r.position);
-        } else if (spec.tracker == Tracker::kUkf && r.bias_corrected) {
-          ukf.addGnss(f.stamp, t.id, *r.observation->position, r.observation->position_covariance);
-        } else if (spec.tracker == Tracker::kUkf) {
-          Eigen::Matrix2d enu;
-          enu << f.position_covariance[0], f.position_covariance[1], f.position_covariance[3],
-              f.position_covariance[4];
-          const Eigen::Matrix2d cov =
-              f.covariance_type == 0 ? Eigen::Matrix2d::Identity() * 9.0 : datum.enuToMap(enu);
-          ukf.addGnss(f.stamp, t.id, r.position, cov);
-        } else if (r.observation) {
-          toTracker(*r.observation);
-        }
-      } else if (e.kind == 1) {
-        const sim::RfidReadingWithTruth& rr = out.rfid[e.index];
-        sensors::RfidRead read;
-        static_cast<core::RfidReading&>(read) = rr;
-        sim::Pose2D mount;  // the antenna pose the node gets from tf: the simulator's (ground truth)
-        for (const auto& m : simulator.config().sensor_layout.rfid_antennas)
-          if (m.frame == rr.mount) mount = m.pose;
-        const sim::Pose2D antenna = simulator.robotPose(rr.robot_index).compose(mount);
-        read.antenna_pose = Eigen::Vector3d(antenna.x, antenna.y, antenna.yaw);
-        const sensors::RfidResult r = rfid_model.process(read);
-        if (r.observation) {
-          if (sensors::addIdentifyingSighting(*r.observation, ingests)) ++result.bias_sightings;
-          identity_evidence.add(*r.observation, gnss_options.association);
-          toTracker(*r.observation);
-        }
-        for (const auto& neg : r.negative) {
-          identity_evidence.add(neg, gnss_options.association);
-          toTracker(neg);
-        }
-      } else {
-#ifdef PL_HAVE_VISION
-        const sim::LaserScanWithTruth& s = out.scans[e.index];
-        // The sensor pose the node gets from tf, here the simulator's (ground truth) laser pose.
-        const Eigen::Isometry3d fixed_from_sensor =
-            Eigen::Translation3d(s.sensor_pose.x, s.sensor_pose.y, 0.0) *
-            Eigen::AngleAxisd(s.sensor_pose.yaw, Eigen::Vector3d::UnitZ());
-        const std::vector<vision::PersonCandidate> candidates = legs->scanCandidates(s, fixed_from_sensor);
-        const std::vector<vision::TrackedPerson> tracked = legs->track(s.frame_id, s.stamp, candidates);
-        if (spec.tracker != Tracker::kUkf)  // as leg_detector publishes it: "nobody at these nodes"
-          if (auto neg = legs->negativeObservation(s.frame_id, s.stamp, s, fixed_from_sensor, candidates,
-                                                   *map, s.robot_id))
-            toTracker(*neg);
-        result.lidar_detections += tracked.size();
-        // Identity for the anonymous people (as gnss_ingest does in the ROS graph): against each picker's
-        // bias-corrected fix and tracker belief.
-        const std::vector<sensors::BeliefView> beliefs =
-            sensors::beliefViews(belief_history, s.stamp, gnss_options.association);
-        std::vector<Eigen::Vector2d> people;
-        for (const auto& t : tracked) {
-          const sensors::AssociationResult a =
-              sensors::associatePerson(vision::LegPipeline::observation(t, *map, s.stamp, s.robot_id),
-                                       ingests, beliefs, *map, gnss_options.association, &identity_evidence);
-          if (a.picker >= 0) {
-            ++result.identified_detections;
-            std::size_t nearest = 0;
-            double best = 1e300;
-            for (std::size_t j = 0; j < n; ++j) {
-              const double d = (simulator.pickerPose(j).position() - t.position).norm();
-              if (d < best) best = d, nearest = j;
-            }
-            if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) ++result.wrong_identifications;
-          }
-          if (a.bias.accepted) {
-            ++result.bias_sightings;
-            PickerTrack& seen = tracks[static_cast<std::size_t>(a.picker)];
-            if (!std::isnan(seen.restart) && std::isnan(seen.seen_after_restart)) seen.seen_after_restart = s.stamp;
-          }
-          if (a.concerns_nobody) continue;  // nobody we track (clutter under the association)
-          if (spec.tracker == Tracker::kUkf) {
-            if (a.picker >= 0)
-              ukf.addGnss(s.stamp, a.observation.picker_id, t.position, a.observation.position_covariance);
-            else
-              people.push_back(t.position);
-          } else {
-            toTracker(a.observation);
-          }
-        }
-        if (spec.tracker == Tracker::kUkf && !people.empty()) ukf.addDetections(s.stamp, people);
-#endif
-      }
+      if (e.kind == 0) run.onFix(out.gnss[e.index]);
+      if (e.kind == 1) run.onRfid(out.rfid[e.index]);
+      if (e.kind == 2) run.onScan(out.scans[e.index]);
     }
-
-    const double now = simulator.time();
-#ifdef PL_HAVE_TPF
-    for (auto& t : tracks)  // periodic prediction when no observation arrives (Table I: 0.25 Hz)
-      if (t.tpf && t.tpf->initialised() && now - t.tpf->lastStamp() >= prediction_period) {
-        t.tpf->predictTo(now);
-        publishBelief(t);
-      }
-#endif
-#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
-    if (planner && (simulator.robot(0).atGoal() || now - last_plan >= replan_period)) {
-      std::vector<nbs::BeliefSource*> views;
-      for (std::size_t i = 0; i < sources.size(); ++i) {
-        // The bias covariance gnss_ingest publishes (GnssBias.covariance), as the nbs_planner node reads it.
-        if (tracks[i].gnss) sources[i]->setBiasCovariance(tracks[i].gnss->bias().appliedCovariance(now));
-        views.push_back(sources[i].get());
-      }
-      const nbs::PlanResult plan = planner->plan(simulator.robot(0).currentNode(), battery_level, views);
-      if (plan.ok()) simulator.setRobotGoal(0, plan.ranked.front().node);
-      last_plan = now;
-    }
-#endif
-    while (next_sample <= now + 1e-9) {
-      for (std::size_t i = 0; i < n; ++i) {
-        NodeIndex est = topology::kInvalidNode;
-#ifdef PL_HAVE_TPF
-        if (tracks[i].tpf && tracks[i].tpf->initialised()) est = tracks[i].tpf->belief().map_node;
-#endif
-        if (spec.tracker == Tracker::kUkf) {
-          if (auto p = ukf.estimate(tracks[i].id)) est = map->nearestNode(*p);
-        }
-        if (spec.tracker == Tracker::kRawFix) est = tracks[i].raw_fix_node;
-        if (est == topology::kInvalidNode) continue;  // no estimate yet (before the first observation)
-        result.samples.push_back(
-            computeError(*map, est, simulator.pickerPose(i).position(), next_sample, tracks[i].id));
-        if (tracks[i].true_gnss_error.allFinite()) {
-          const sensors::GnssBiasEstimator& b = tracks[i].gnss->bias();
-          BiasSample bs;
-          bs.sighting_age = b.sighted() ? next_sample - b.lastSighting() : std::numeric_limits<double>::infinity();
-          bs.residual = (tracks[i].true_gnss_error - b.applied(next_sample)).norm();
-          bs.lane_applicable = result.samples.back().lane_applicable;
-          bs.in_true_lane = result.samples.back().in_true_lane;
-          result.bias_samples.push_back(bs);
-        }
-        PickerTrack& t = tracks[i];
-        if (!std::isnan(t.seen_after_restart)) {
-          const ErrorSample& e = result.samples.back();
-          const double since = next_sample - t.seen_after_restart;
-          if ((e.lane_applicable && e.in_true_lane) || since > 120.0) {
-            result.lane_delays.push_back(e.lane_applicable && e.in_true_lane ? since
-                                                                             : std::numeric_limits<double>::infinity());
-            t.restart = t.seen_after_restart = std::nan("");
-          }
-        }
-      }
-      next_sample += config.sample_period;
-    }
+    run.endOfStep(simulator.time());
+    for (; next_sample <= simulator.time() + 1e-9; next_sample += config.sample_period)
+      run.sample(next_sample);
   }
+  RunResult result = std::move(run.result());
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
 }
-#else
-RunResult runOnce(std::shared_ptr<const topology::TopologicalMap>, const RunConfig& config) {
-  throw std::runtime_error("method " + config.method +
-                           " unavailable: " + methodUnavailableReason(config.method, config));
-}
-#endif
 
 namespace {
 
@@ -615,12 +568,8 @@ void logUnknownKeys(const RunConfig& config, std::ostream& log) {
   };
   check(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"), sensors::GnssIngestOptions::fromYamlFile);
   check(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml"), sensors::RfidModelOptions::fromYamlFile);
-#ifdef PL_HAVE_TPF
   check(resolveConfigFile(config.tpf_config, "tpf.yaml"), tpf::TpfParams::fromYamlFile);
-#endif
-#if defined(PL_HAVE_NBS) && defined(PL_HAVE_TPF)
   check(resolveConfigFile(config.nbs_config, "nbs.yaml"), nbs::PlannerConfig::fromYamlFile);
-#endif
 }
 
 }  // namespace

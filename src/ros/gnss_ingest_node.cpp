@@ -54,6 +54,7 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   }
 
   options_ = o;
+  fleet_ = std::make_unique<sensors::GnssFleet>(map_, *datum_, o);
   std::string topic, person_topic;
   pnh.param<std::string>("observation_topic", topic, "/observations");
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
@@ -136,11 +137,7 @@ void GnssIngestNode::adoptMap(std::shared_ptr<const topology::TopologicalMap> ma
     }
   }
   map_ = std::move(map);
-  for (auto& p : pickers_) {
-    p->ingest.setMap(map_, *datum_, datum_moved);
-    p->beliefs.clear();  // node indices of the old map; the tracker's next beliefs refill them
-  }
-  identity_.clear();
+  fleet_->adoptMap(map_, *datum_, datum_moved);
   const std::size_t dropped = ordering_.size();
   ordering_.clear();  // people decoded on the old map's nodes
   if (dropped > 0)
@@ -151,7 +148,13 @@ void GnssIngestNode::adoptMap(std::shared_ptr<const topology::TopologicalMap> ma
 bool GnssIngestNode::addPicker(const core::PickerConfig& p) {
   if (p.gnss_topic.empty()) return true;
   // Made whole before it is listed: a picker is either subscribed and counted, or not there at all.
-  auto picker = std::make_unique<Picker>(p, map_, *datum_, options_);
+  sensors::GnssFleet::Picker* core = fleet_->add(p.id);
+  if (!core) {
+    ++pickers_refused_;
+    ROS_WARN("gnss_ingest: picker %s listed twice: followed once", p.id.c_str());
+    return false;
+  }
+  auto picker = std::make_unique<Picker>(p, core);
   Picker* raw = picker.get();
   try {
     const std::string problem = gnssTopicProblem(p.gnss_topic);
@@ -162,6 +165,7 @@ bool GnssIngestNode::addPicker(const core::PickerConfig& p) {
     raw->bias_topic = nh_.resolveName(bias_prefix_ + "/" + p.id + "/gnss_bias");
   } catch (const std::exception& e) {
     ++pickers_refused_;
+    fleet_->remove(p.id);
     ROS_WARN("gnss_ingest: picker %s not followed: %s", p.id.c_str(), e.what());
     return false;
   }
@@ -192,6 +196,7 @@ void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
     const auto w = wanted.find((*it)->config.id);
     if (w == wanted.end() || w->second.gnss_topic != (*it)->config.gnss_topic) {
       by_id_.erase((*it)->config.id);
+      fleet_->remove((*it)->config.id);
       it = pickers_.erase(it);  // its subscriptions and bias topic go with it
       ++removed;
     } else {
@@ -207,29 +212,12 @@ void GnssIngestNode::onRegistry(const core::PickerRegistry& registry) {
              pickers_.size());
 }
 
-std::vector<const sensors::BeliefHistory*> GnssIngestNode::beliefHistories() const {
-  std::vector<const sensors::BeliefHistory*> out;
-  out.reserve(pickers_.size());
-  for (const auto& p : pickers_) out.push_back(&p->beliefs);
-  return out;
-}
-
-std::vector<sensors::GnssIngest*> GnssIngestNode::pickerPointers() {
-  std::vector<sensors::GnssIngest*> pickers;
-  pickers.reserve(pickers_.size());
-  for (auto& p : pickers_) pickers.push_back(&p->ingest);
-  return pickers;
-}
-
 bool GnssIngestNode::checkClock() {
   if (!stamp_guard_.clockJumpedBack()) return false;
   // A bag replayed with -l or a simulator restart: forget every picker's fix history, bias estimate, the
   // beliefs and what waits for stamp order (else every later fix would be "not after the last accepted one").
   ROS_WARN("gnss_ingest: the clock jumped back: fix histories, bias estimates and beliefs reset");
-  for (auto& p : pickers_) {
-    p->ingest = sensors::GnssIngest(p->config.id, map_, *datum_, options_);
-    p->beliefs.clear();
-  }
+  fleet_->reset();
   ordering_.clear();
   return true;
 }
@@ -300,8 +288,8 @@ void GnssIngestNode::acceptPerson(core::Observation person, const std::string& k
 void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstPtr& msg) {
   diagnostics_.tick("identifying observations");
   // Cheap filter before converting: this topic carries every observation of the fleet.
+  if (!fleet_->wantsIdentified(msg->identifying, msg->sensor)) return;
   const bool evidence = options_.association.enabled && options_.association.isIdentitySensor(msg->sensor);
-  if (!msg->identifying || !(evidence || options_.bias.isSightingSensor(msg->sensor))) return;
   checkClock();
   if (stamp_guard_.tooFarInFuture(msg->header.stamp)) return;
   Input in;
@@ -317,8 +305,7 @@ void GnssIngestNode::onIdentified(const picker_localisation::Observation::ConstP
 }
 
 void GnssIngestNode::useIdentified(const core::Observation& obs) {
-  if (options_.association.enabled) identity_.add(obs, options_.association);
-  if (obs.position) sensors::addIdentifyingSighting(obs, pickerPointers());
+  fleet_->useIdentified(obs);
 }
 
 void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
@@ -342,13 +329,11 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
     nodes.push_back(*n);
     masses.push_back(msg.masses[k]);
   }
-  if (!core::normaliseMasses(masses)) {
+  if (!fleet_->addBelief(msg.picker_id, msg.header.stamp.toSec(), nodes, std::move(masses))) {
     ++bad_beliefs_;
     ROS_WARN_THROTTLE(10.0, "gnss_ingest: belief of %s dropped: no node of this map with a positive mass",
                       msg.picker_id.c_str());
-    return;
   }
-  it->second->beliefs.push(msg.header.stamp.toSec(), nodes, masses);
 }
 
 void GnssIngestNode::releaseOrdered() {
@@ -467,8 +452,8 @@ void GnssIngestNode::onPickerPose(const geometry_msgs::PoseWithCovarianceStamped
 }
 
 void GnssIngestNode::processFix(Picker& picker, const core::GnssFix& fix) {
-  sensors::GnssIngest& g = picker.ingest;
-  sensors::GnssResult r = g.process(fix);
+  const sensors::GnssIngest& g = picker.core->ingest;
+  const sensors::GnssResult r = fleet_->processFix(*picker.core, fix);
   if (!r.accepted()) {
     ROS_WARN_THROTTLE(5.0, "gnss_ingest: %s: fix at %.3f rejected (%s): %s", g.pickerId().c_str(), fix.stamp,
                       sensors::toString(r.rejection), r.reason.c_str());
@@ -482,26 +467,17 @@ void GnssIngestNode::processFix(Picker& picker, const core::GnssFix& fix) {
 }
 
 void GnssIngestNode::processPerson(const core::Observation& person) {
-  ++people_;
-  const sensors::AssociationResult a = sensors::associatePerson(
-      person, pickerPointers(), sensors::beliefViews(beliefHistories(), person.stamp, options_.association),
-      *map_, options_.association, &identity_);
-  if (a.picker >= 0) {
-    ++identified_;
-    if (!a.bias.accepted)
-      ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
-                a.bias.reason.c_str());
-  }
-  if (a.concerns_nobody) {
-    ++nobody_;
-    return;
-  }
+  const sensors::AssociationResult a = fleet_->associate(person);
+  if (a.picker >= 0 && !a.bias.accepted)
+    ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
+              a.bias.reason.c_str());
+  if (a.concerns_nobody) return;
   pub_.publish(toMsg(a.observation, *map_, frame_id_));
   ++published_;
 }
 
 void GnssIngestNode::publishBias(Picker& picker, double stamp, const sensors::GnssResult& r) {
-  const sensors::GnssIngest& g = picker.ingest;
+  const sensors::GnssIngest& g = picker.core->ingest;
   const sensors::GnssBiasEstimator& b = g.bias();
   const bool used = b.usable(stamp);
   const Eigen::Vector2d bias = b.applied(stamp);
@@ -568,7 +544,7 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("fixes stamped in the future (rejected)", stamp_guard_.futureStamps());
   stat.add("clock jumps back", stamp_guard_.jumps());
   for (const auto& p : pickers_) {
-    const sensors::GnssIngest& g = p->ingest;
+    const sensors::GnssIngest& g = p->core->ingest;
     const sensors::GnssCounters& c = g.counters();
     const std::string k = g.pickerId() + " ";
     stat.add(k + "received", c.received);
@@ -586,8 +562,8 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   }
   stat.add("published", published_);
   stat.add("people received / identified / nobody's / malformed",
-           std::to_string(people_) + " / " + std::to_string(identified_) + " / " + std::to_string(nobody_) + " / " +
-               std::to_string(bad_people_));
+           std::to_string(fleet_->counters().people) + " / " + std::to_string(fleet_->counters().identified) +
+               " / " + std::to_string(fleet_->counters().nobody) + " / " + std::to_string(bad_people_));
   stat.add("picker poses published / dropped", std::to_string(picker_poses_) + " / " + std::to_string(bad_poses_));
   stat.add("people messages refused (over max_people_per_message)", people_arrays_refused_);
   stat.add("beliefs dropped (future stamp, no valid mass)", bad_beliefs_);
@@ -597,7 +573,7 @@ void GnssIngestNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("pickers with GNSS", pickers_.size());
   stat.add("picker lists received", registry_updates_);
   for (const auto& p : pickers_) {
-    const sensors::GnssIngest& g = p->ingest;
+    const sensors::GnssIngest& g = p->core->ingest;
     const sensors::GnssBiasEstimator& b = g.bias();
     stat.add(g.pickerId() + " bias sightings accepted/refused",
              std::to_string(b.sightings()) + "/" + std::to_string(b.refused()));

@@ -87,12 +87,6 @@ tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string&
   return tpf::TpfParams::fromYaml(merged);
 }
 
-std::uint64_t seedFromId(const std::string& id) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : id) h = (h ^ c) * 1099511628211ull;
-  return h == 0 ? 1 : h;
-}
-
 picker_localisation::PickerBelief toBeliefMsg(const tpf::Belief& b, const topology::TopologicalMap& map,
                                               const std::string& picker_id, const std::string& frame_id) {
   picker_localisation::PickerBelief m;
@@ -207,19 +201,18 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& b, const topology::
   return arr;
 }
 
+// One picker's ROS side; its filter, prediction schedule and counters are the fleet's (tpf::TrackerFleet).
 struct TpfTracker::Track {
-  std::string id;
-  std::unique_ptr<tpf::TopologicalParticleFilter> filter;
-  double prediction_period = 0.0;  // s; 0: no periodic prediction
+  tpf::TrackerFleet::Track* core = nullptr;
+  const std::string& id() const { return core->id; }
+  tpf::TopologicalParticleFilter& filter() const { return *core->filter; }
   LastValuePublisher<picker_localisation::PickerBelief> belief_pub;
   LastValuePublisher<geometry_msgs::PoseWithCovarianceStamped> estimate_pub;
   LastValuePublisher<std_msgs::String> current_node_pub;  // LCAS coordination's <agent>/current_node
   std::string current_node;                               // the last one published
   CountedPublisher markers_pub;
   ros::ServiceServer reset_srv, what_if_srv;
-  std::uint64_t received = 0, unknown_nodes = 0, what_if_calls = 0, resets = 0, last_reported_problems = 0,
-                exceptions = 0;
-  std::string last_problem;
+  std::uint64_t unknown_nodes = 0, what_if_calls = 0, last_reported_problems = 0;
   std::string belief_topic, estimate_topic, markers_topic, current_node_topic;  // resolved names ("": none)
 };
 
@@ -257,6 +250,10 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   pnh.param("seed", seed_param_, 0);
   map_ = obtainMap(nh, pnh);
   if (!map_) return;  // obtainMap logged why
+  fleet_ = std::make_unique<tpf::TrackerFleet>(map_, [this](tpf::TrackerFleet::Track& core) {
+    const auto it = tracks_.find(core.id);
+    if (it != tracks_.end()) publish(*it->second);
+  });
 
   std::string observations_topic;
   pnh.param<std::string>("topic_prefix", prefix_, "/pickers");
@@ -320,24 +317,19 @@ TpfTracker::~TpfTracker() { ros::getGlobalCallbackQueue()->removeByID(reinterpre
 bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error,
                             std::vector<std::string>* unknown) {
   tpf::TpfParams params;
-  auto t = std::make_unique<Track>();
-  Track* raw = t.get();
-  t->id = picker.id;
   try {
     params = tpfParamsWithOverrides(base_params_, picker.tpf_overrides, unknown);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
   }
-  try {
-    const std::uint64_t seed =
-        seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(picker.id);
-    t->filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, params, seed);
-  } catch (const std::exception& e) {  // std::bad_alloc: this picker is refused, the others go on
-    *error = std::string("its filter could not be made: ") + e.what();
-    return false;
-  }
-  t->prediction_period = params.prediction_rate > 0.0 ? 1.0 / params.prediction_rate : 0.0;
+  const std::uint64_t seed =
+      tpf::TrackerFleet::seedFor(picker.id, seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : 0);
+  tpf::TrackerFleet::Track* core = fleet_->add(picker.id, params, seed, error);
+  if (!core) return false;  // std::bad_alloc: this picker is refused, the others go on
+  auto t = std::make_unique<Track>();
+  Track* raw = t.get();
+  t->core = core;
   const std::string base = prefix_ + "/" + picker.id;
   t->belief_topic = nh_.resolveName(base + "/belief");
   t->estimate_topic = nh_.resolveName(base + "/estimate");
@@ -346,25 +338,26 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
     t->current_node_topic =
         nh_.resolveName((current_node_ns_ == "/" ? std::string() : current_node_ns_) + "/" + picker.id + "/current_node");
   advertiseTopics(*t);
-  t->reset_srv = nh_.advertiseService<picker_localisation::ResetBelief::Request, picker_localisation::ResetBelief::Response>(
-      base + "/reset", [this, raw](picker_localisation::ResetBelief::Request&, picker_localisation::ResetBelief::Response& res) {
-        raw->filter->reset();
-        ++raw->resets;
+  t->reset_srv = nh_.advertiseService<picker_localisation::ResetBelief::Request,
+                                      picker_localisation::ResetBelief::Response>(
+      base + "/reset", [this, raw](picker_localisation::ResetBelief::Request&,
+                                   picker_localisation::ResetBelief::Response& res) {
+        fleet_->reset(*raw->core);
         res.success = true;
-        res.message = "belief of " + raw->id + " forgotten; the next observation initialises it";
-        publish(*raw);
+        res.message = "belief of " + raw->id() + " forgotten; the next observation initialises it";
         flush();
         return true;
       });
   t->what_if_srv = nh_.advertiseService<picker_localisation::WhatIf::Request, picker_localisation::WhatIf::Response>(
       base + "/what_if", [this, raw](picker_localisation::WhatIf::Request& req, picker_localisation::WhatIf::Response& res) {
         ++raw->what_if_calls;
-        const tpf::TopologicalParticleFilter& f = *raw->filter;
+        const tpf::TopologicalParticleFilter& f = raw->filter();
         if (!(req.horizon >= 0.0 && req.horizon <= kMaxWhatIfHorizon)) {
           res.success = false;
           res.message =
               "horizon must be in [0, " + std::to_string(static_cast<int>(kMaxWhatIfHorizon)) + "] s";
-          ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: what_if refused: %s", raw->id.c_str(), res.message.c_str());
+          ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: what_if refused: %s", raw->id().c_str(),
+                            res.message.c_str());
           return true;
         }
         tpf::Belief b;
@@ -379,20 +372,20 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
           if (!r.ok()) {
             res.success = false;
             res.message = std::string("hypothetical observation ") + tpf::toString(r.status) + ": " + r.reason;
-            res.belief = toBeliefMsg(b, *map_, raw->id, frame_id_);
+            res.belief = toBeliefMsg(b, *map_, raw->id(), frame_id_);
             return true;
           }
         } else {
           if (!f.initialised()) {
             res.success = false;
-            res.message = "no belief yet: " + raw->id + " has received no observation";
-            res.belief = toBeliefMsg(f.belief(), *map_, raw->id, frame_id_);
+            res.message = "no belief yet: " + raw->id() + " has received no observation";
+            res.belief = toBeliefMsg(f.belief(), *map_, raw->id(), frame_id_);
             return true;
           }
           b = f.predictAhead(req.horizon, req.seed);
         }
         res.success = true;
-        res.belief = toBeliefMsg(b, *map_, raw->id, frame_id_);
+        res.belief = toBeliefMsg(b, *map_, raw->id(), frame_id_);
         return true;
       });
   diagnostics_.add("tpf_tracker " + picker.id,
@@ -401,7 +394,7 @@ bool TpfTracker::startTrack(const core::PickerConfig& picker, std::string* error
   publish(*raw);  // "waiting for the first observation": the topic exists from the start
   flush();
   ROS_INFO("tpf_tracker %s: %zu particles, method %s motion, prediction every %.1f s", picker.id.c_str(),
-           params.num_particles, tpf::toString(params.motion_model), raw->prediction_period);
+           params.num_particles, tpf::toString(params.motion_model), core->prediction_period);
   return true;
 }
 
@@ -419,7 +412,7 @@ void TpfTracker::advertiseTopics(Track& t) {
   advertiseWhileWanted(t.markers_pub, t.markers_topic, demand, [&] {
     t.markers_pub = CountedPublisher::advertise<visualization_msgs::MarkerArray>(
         nh_, t.markers_topic, 2, [this, raw](const ros::SingleSubscriberPublisher& s) {
-          s.publish(toMarkers(raw->filter->belief(), *map_, raw->id, frame_id_));
+          s.publish(toMarkers(raw->filter().belief(), *map_, raw->id(), frame_id_));
         });
   });
 }
@@ -427,10 +420,7 @@ void TpfTracker::advertiseTopics(Track& t) {
 void TpfTracker::updatePredictionTimer() {
   // One timer for every picker, ticking at 4x the fastest prediction rate so a prediction happens within a
   // quarter period of falling due.
-  double fastest = 0.0;
-  for (const auto& kv : tracks_)
-    if (kv.second->prediction_period > 0.0 && (fastest == 0.0 || kv.second->prediction_period < fastest))
-      fastest = kv.second->prediction_period;
+  const double fastest = fleet_->fastestPredictionPeriod();
   if (fastest <= 0.0) {  // no picker predicts periodically: no timer
     prediction_timer_.stop();
     prediction_timer_ = ros::Timer();
@@ -444,22 +434,9 @@ void TpfTracker::updatePredictionTimer() {
 
 std::vector<TpfTracker::Track*> TpfTracker::route(bool identifying, const std::string& picker_id,
                                                   const std::vector<std::string>& candidates) {
-  // core::concernsPicker's rule, by lookup: the picker identified, the candidates, or (anonymous) everyone.
   std::vector<Track*> out;
-  if (identifying) {
-    const auto it = tracks_.find(picker_id);
-    if (it != tracks_.end()) out.push_back(it->second.get());
-    return out;
-  }
-  if (!candidates.empty()) {
-    for (const std::string& id : candidates) {
-      const auto it = tracks_.find(id);
-      if (it != tracks_.end()) out.push_back(it->second.get());
-    }
-    return out;
-  }
-  out.reserve(tracks_.size());
-  for (auto& kv : tracks_) out.push_back(kv.second.get());
+  for (tpf::TrackerFleet::Track* core : fleet_->route(identifying, picker_id, candidates))
+    out.push_back(tracks_.at(core->id).get());
   return out;
 }
 
@@ -488,15 +465,12 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
   }
   std::size_t unknown = 0;
   Pending p{fromMsg(*msg, *map_, &unknown), msg->sensor};  // decoded once, whoever it concerns
-  for (Track* t : targets) {
-    ++t->received;
-    t->unknown_nodes += unknown;
-  }
+  for (Track* t : targets) t->unknown_nodes += unknown;
   if (unknown > 0)
     ROS_WARN_THROTTLE(5.0, "tpf_tracker: %zu node name(s) of a %s observation are not in the map (skipped)", unknown,
                       msg->sensor.c_str());
   if (ordering_latency_ <= 0.0) {
-    for (Track* t : targets) process(*t, p.obs, p.sensor);
+    for (Track* t : targets) report(fleet_->process(*t->core, p.obs), p.sensor);
     flushWhenIdle();
     return;
   }
@@ -509,7 +483,21 @@ void TpfTracker::observationCallback(const picker_localisation::Observation::Con
 
 void TpfTracker::dispatch(const Pending& p) {
   // Routed again on release: a picker may have been added or removed while the observation waited.
-  for (Track* t : route(p.obs.identifying, p.obs.picker_id, p.obs.candidate_pickers)) process(*t, p.obs, p.sensor);
+  for (const tpf::TrackerFleet::Outcome& o : fleet_->process(p.obs)) report(o, p.sensor);
+}
+
+void TpfTracker::report(const tpf::TrackerFleet::Outcome& o, const std::string& sensor) {
+  const tpf::TrackerFleet::Track& t = *o.track;
+  if (o.exception) {
+    // Nothing a callback meets may stop the node (roscpp would end the process, and roslaunch the robot): the
+    // fleet forgot the picker's belief, the next observation initialises it again.
+    ROS_ERROR_THROTTLE(5.0, "tpf_tracker %s: %s; belief reset", t.id.c_str(), t.last_problem.c_str());
+  } else if (!o.result.ok() && o.result.status != tpf::UpdateStatus::kIgnoredSensor) {
+    ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", t.id.c_str(), sensor.c_str(),
+                      t.last_problem.c_str());
+  } else if (o.result.reinitialised) {
+    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", t.id.c_str(), t.filter->belief().jsd);
+  }
 }
 
 void TpfTracker::checkClockJump() {
@@ -517,11 +505,7 @@ void TpfTracker::checkClockJump() {
   ROS_WARN("tpf_tracker: the clock jumped back: %zu belief(s) reset, %zu waiting observation(s) dropped",
            tracks_.size(), ordering_.size());
   ordering_.clear();
-  for (auto& kv : tracks_) {
-    kv.second->filter->reset();
-    ++kv.second->resets;
-    publish(*kv.second);
-  }
+  fleet_->resetAll();
   flush();
 }
 
@@ -531,20 +515,9 @@ void TpfTracker::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
   const std::size_t dropped = ordering_.size();
   ordering_.clear();  // decoded on the old map's node indices
   map_ = std::move(map);
-  for (auto& kv : tracks_) {
-    Track& t = *kv.second;
-    try {
-      t.filter->adoptMap(map_, change.old_to_new);
-    } catch (const std::exception& e) {
-      // The filter is still on the old map (adoptMap changes nothing when it throws): a fresh one on the new
-      // map, its belief forgotten, so every filter and this node share one map.
-      ROS_ERROR("tpf_tracker %s: belief not carried to the new map (%s); starting afresh", t.id.c_str(), e.what());
-      ++t.exceptions;
-      t.filter = std::make_unique<tpf::TopologicalParticleFilter>(map_, t.filter->params(),
-                                                                  seed_param_ > 0 ? static_cast<std::uint64_t>(seed_param_) : seedFromId(t.id));
-    }
-    publish(t);  // current_node is sent when its name changed (renamed, removed)
-  }
+  // current_node is sent when its name changed (renamed, removed)
+  for (const std::string& id : fleet_->adoptMap(map_, change.old_to_new))
+    ROS_ERROR("tpf_tracker %s: %s; starting afresh", id.c_str(), fleet_->find(id)->last_problem.c_str());
   flush();
   ++map_updates_;
   if (dropped > 0)
@@ -559,72 +532,20 @@ void TpfTracker::orderingTick(const ros::TimerEvent&) {
   flush();
 }
 
-void TpfTracker::predictDueUntil(Track& t, double until) {
-  if (t.prediction_period <= 0.0) return;
-  tpf::TopologicalParticleFilter& f = *t.filter;
-  int steps = 0;
-  while (f.initialised() && until - f.lastStamp() >= t.prediction_period) {
-    const double next = ++steps < kMaxPredictionsPerCall ? f.lastStamp() + t.prediction_period
-                                                          : until;  // a long silence: one step to `until`
-    if (!f.predictTo(next)) break;
-    publish(t);
-  }
-}
-
-
-void TpfTracker::process(Track& t, const core::Observation& obs, const std::string& sensor) {
-  tpf::UpdateResult r;
-  try {
-    if (std::isfinite(obs.stamp)) predictDueUntil(t, obs.stamp);
-    r = t.filter->update(obs);
-  } catch (const std::exception& e) {
-    caught(t, e);
-    return;
-  }
-  if (!r.ok()) {
-    if (r.status != tpf::UpdateStatus::kIgnoredSensor) {
-      t.last_problem = std::string(tpf::toString(r.status)) + ": " + r.reason;
-      ROS_WARN_THROTTLE(5.0, "tpf_tracker %s: %s observation %s", t.id.c_str(), sensor.c_str(), t.last_problem.c_str());
-    }
-    return;
-  }
-  if (r.reinitialised)
-    ROS_INFO_THROTTLE(5.0, "tpf_tracker %s: re-initialised (JSD %.3f)", t.id.c_str(), t.filter->belief().jsd);
-  publish(t);
-}
-
 void TpfTracker::predictionTick(const ros::TimerEvent&) {
   checkClockJump();
   const double now = ros::Time::now().toSec();
   if (now <= 0.0) return;  // sim clock not running yet
   // Predictions wait for the ordering latency too, so none overtakes an observation still in the buffer.
-  for (auto& kv : tracks_) {
-    try {
-      predictDueUntil(*kv.second, now - ordering_latency_);
-    } catch (const std::exception& e) {
-      caught(*kv.second, e);
-    }
-  }
+  fleet_->predictDue(now - ordering_latency_);
   flush();
-}
-
-void TpfTracker::caught(Track& t, const std::exception& e) {
-  // Nothing a callback meets may stop the node (roscpp would end the process, and roslaunch the robot): the
-  // picker's belief is forgotten, the next observation initialises it again.
-  ++t.exceptions;
-  t.last_problem = std::string("exception: ") + e.what();
-  ROS_ERROR_THROTTLE(5.0, "tpf_tracker %s: %s; belief reset", t.id.c_str(), t.last_problem.c_str());
-  try {
-    t.filter->reset();
-  } catch (const std::exception&) {
-  }
 }
 
 void TpfTracker::publish(Track& t) {
   // Queued, sent by flush(): messages published back to back cost roscpp's poll thread one walk over every
   // publication of the process, not one walk each.
-  const tpf::Belief& b = t.filter->belief();
-  Outgoing out{&t, toBeliefMsg(b, *map_, t.id, frame_id_), std::nullopt, std::nullopt, std::nullopt};
+  const tpf::Belief& b = t.filter().belief();
+  Outgoing out{&t, toBeliefMsg(b, *map_, t.id(), frame_id_), std::nullopt, std::nullopt, std::nullopt};
   if (b.initialised) out.estimate = toEstimateMsg(b, *map_, frame_id_);
   if (b.initialised && !t.current_node_topic.empty() && map_->node(b.map_node).name != t.current_node) {
     t.current_node = map_->node(b.map_node).name;  // sent on change, latched (as LCAS agents do)
@@ -632,7 +553,7 @@ void TpfTracker::publish(Track& t) {
     node.data = t.current_node;
     out.current_node = node;
   }
-  if (t.markers_pub.hasSubscribers()) out.markers = toMarkers(b, *map_, t.id, frame_id_);
+  if (t.markers_pub.hasSubscribers()) out.markers = toMarkers(b, *map_, t.id(), frame_id_);
   outgoing_.push_back(std::move(out));
 }
 
@@ -743,7 +664,8 @@ bool TpfTracker::removePicker(picker_localisation::RemovePicker::Request& req,
   for (auto& m : gone.markers) m.action = visualization_msgs::Marker::DELETE;
   it->second->markers_pub.publish(gone);
   diagnostics_.removeByName("tpf_tracker " + req.id);
-  tracks_.erase(it);  // its filter, publishers and services go with it
+  tracks_.erase(it);  // its publishers and services go with it
+  fleet_->remove(req.id);
   registry_.remove(req.id);
   ++removed_;
   updatePredictionTimer();  // a fast picker gone: the timer slows down (or stops) with it
@@ -784,11 +706,12 @@ void TpfTracker::diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat
 }
 
 void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  const auto& c = t.filter->counters();
-  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old + t.exceptions;
-  stat.hardware_id = t.id;
-  stat.add("picker_id", t.id);
-  stat.add("observations received", t.received);
+  const tpf::TrackerFleet::Track& core = *t.core;
+  const auto& c = core.filter->counters();
+  const std::uint64_t problems = c.rejected_invalid + c.dropped_too_old + core.exceptions;
+  stat.hardware_id = core.id;
+  stat.add("picker_id", core.id);
+  stat.add("observations received", core.received);
   stat.add("observations stamped in the future (dropped)", stamp_guard_.futureStamps());
   stat.add("accepted", c.accepted);
   stat.add("reordered (late, within window)", c.reordered);
@@ -796,19 +719,19 @@ void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper&
   stat.add("rejected (invalid)", c.rejected_invalid);
   stat.add("ignored (sensor not fused in this mode)", c.ignored_sensor);
   stat.add("unknown node names skipped", t.unknown_nodes);
-  stat.add("exceptions caught (belief reset)", t.exceptions);
+  stat.add("exceptions caught (belief reset)", core.exceptions);
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);
   stat.add("predictions", c.predictions);
   stat.add("what-if calls", t.what_if_calls);
-  stat.add("resets", t.resets);
-  const auto& b = t.filter->belief();
+  stat.add("resets", core.resets);
+  const auto& b = core.filter->belief();
   stat.add("entropy (nats)", b.entropy);
   stat.add("jsd", b.jsd);
   stat.add("p_rj", b.unconnected_jump_probability);
   if (b.initialised && b.map_node < map_->numNodes()) stat.add("estimated node", map_->node(b.map_node).name);
   if (problems > t.last_reported_problems) {
-    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, t.last_problem);
+    stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, core.last_problem);
   } else if (!b.initialised) {
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "waiting for the first observation");
   } else {

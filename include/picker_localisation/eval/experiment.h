@@ -59,7 +59,8 @@ struct RunConfig {
   std::string vision_config;       // leg_detector section (vision::LegPipelineOptions, as the node): "" =
                                   // config/vision.yaml, then the simulated-laser overlay config/vision_sim.yaml
                                   // (leg_threshold 0.42 = 0.3 at 0.5 deg); else comma-separated files applied in order
-  std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else from this (to measure filter noise)
+  std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else each from its picker id mixed with
+                                   // this, as tpf_tracker with ~seed (tpf::TrackerFleet::seedFor)
 };
 
 // The file a RunConfig field resolves to ("" = built-in defaults): see RunConfig.

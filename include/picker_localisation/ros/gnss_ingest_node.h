@@ -25,15 +25,12 @@ class GnssIngestNode {
   bool ok() const { return ok_; }
 
  private:
-  // One picker with a GNSS device: its ingest (fix checks, bias estimate), its tracker's recent beliefs, its
-  // subscriptions and bias topic.
+  // One picker with a GNSS device: its subscription and bias topic (its ingest and the tracker's recent
+  // beliefs are the fleet's).
   struct Picker {
-    Picker(const core::PickerConfig& config, std::shared_ptr<const topology::TopologicalMap> map,
-           const core::GeodeticDatum& datum, const sensors::GnssIngestOptions& options)
-        : config(config), ingest(config.id, std::move(map), datum, options) {}
+    Picker(const core::PickerConfig& config, sensors::GnssFleet::Picker* core) : config(config), core(core) {}
     core::PickerConfig config;
-    sensors::GnssIngest ingest;
-    sensors::BeliefHistory beliefs;
+    sensors::GnssFleet::Picker* core;
     ros::Subscriber fix_sub;
     LastValuePublisher<picker_localisation::GnssBias> bias_pub;
     std::string bias_topic;  // resolved name
@@ -68,8 +65,6 @@ class GnssIngestNode {
   bool checkClock();
   // A new map from the map topic (MapFollower): every picker's ingest, and the datum when the map's moved.
   void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
-  std::vector<sensors::GnssIngest*> pickerPointers();
-  std::vector<const sensors::BeliefHistory*> beliefHistories() const;
   void releaseOrdered();
   void processFix(Picker& picker, const core::GnssFix& fix);
   void processPerson(const core::Observation& person);
@@ -84,7 +79,8 @@ class GnssIngestNode {
   std::unique_ptr<MapFollower> map_follower_;
   std::string frame_id_, bias_prefix_;
   sensors::GnssIngestOptions options_;
-  sensors::IdentityEvidence identity_;  // RFID reads / failed reads per picker (association_identity_sensors)
+  std::unique_ptr<sensors::GnssFleet>
+      fleet_;  // every picker's ingest, the association, the identity evidence
   std::vector<std::unique_ptr<Picker>> pickers_;  // in the order of the list
   std::unordered_map<std::string, Picker*> by_id_;
   std::vector<ros::Subscriber> subs_;
@@ -95,7 +91,7 @@ class GnssIngestNode {
   double ordering_latency_ = 0.0;
   ros::Timer ordering_timer_;
   NodeDiagnostics diagnostics_;
-  std::size_t published_ = 0, people_ = 0, identified_ = 0, nobody_ = 0, bad_people_ = 0, registry_updates_ = 0;
+  std::size_t published_ = 0, bad_people_ = 0, registry_updates_ = 0;
   std::size_t picker_poses_ = 0, bad_poses_ = 0, people_arrays_refused_ = 0, bad_beliefs_ = 0,
               pickers_refused_ = 0;
   std::size_t max_people_per_message_ = 100;  // ~max_people_per_message: a larger PoseArray is refused whole

@@ -34,6 +34,7 @@
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
+#include "picker_localisation/sensors_ranging/gnss_fleet.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/picker_association.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"

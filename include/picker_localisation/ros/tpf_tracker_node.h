@@ -37,8 +37,9 @@
 // filter (adoptMap), a malformed one refused (MapFollower).
 // Parameters (private): pickers_file or picker_id, map_file (else the latched topological_map topic),
 // tpf_params_file (YAML like config/tpf.yaml) overridden key by key by private parameters with the same
-// names (e.g. ~num_particles, ~method) and then by a picker's own overrides, seed (0: derived from each
-// picker's id), frame_id (map), max_future_stamp (10 s).
+// names (e.g. ~num_particles, ~method) and then by a picker's own overrides, seed (each picker's filter is
+// seeded from its id, mixed with ~seed when > 0: tpf::TrackerFleet::seedFor, as the runner's --tracker-seed),
+// frame_id (map), max_future_stamp (10 s).
 #pragma once
 
 #include "picker_localisation/ros/node_diagnostics.h"
@@ -69,13 +70,10 @@
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
-#include "picker_localisation/tpf/topological_particle_filter.h"
+#include "picker_localisation/tpf/tracker_fleet.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
-
-// Stable 64-bit seed from a picker id (FNV-1a), never 0.
-std::uint64_t seedFromId(const std::string& id);
 
 // Messages from a filter's belief (frame_id: map frame).
 picker_localisation::PickerBelief toBeliefMsg(const tpf::Belief& belief, const topology::TopologicalMap& map,
@@ -105,7 +103,7 @@ class TpfTracker {
   std::size_t size() const { return tracks_.size(); }
 
  private:
-  struct Track;  // one picker: filter, topics, services, counters
+  struct Track;      // one picker's topics, services and adapter counters (its filter is the fleet's)
   struct Outgoing {  // one belief's messages, queued by publish() and sent by flush()
     Track* track;
     picker_localisation::PickerBelief belief;
@@ -126,10 +124,8 @@ class TpfTracker {
   void dispatch(const Pending& p);
   void predictionTick(const ros::TimerEvent&);
   void orderingTick(const ros::TimerEvent&);
-  // Fuses one observation after the periodic predictions that fall due before its stamp.
-  void process(Track& t, const core::Observation& obs, const std::string& sensor);
-  // Periodic predictions at lastStamp + k * period up to `until` (s).
-  void predictDueUntil(Track& t, double until);
+  // One throttled log line for a refused observation, an exception or a re-initialisation.
+  void report(const tpf::TrackerFleet::Outcome& outcome, const std::string& sensor);
   void publish(Track& t);
   void flush();
   void flushWhenIdle();
@@ -139,11 +135,9 @@ class TpfTracker {
   bool addPicker(picker_localisation::AddPicker::Request& req, picker_localisation::AddPicker::Response& res);
   bool removePicker(picker_localisation::RemovePicker::Request& req,
                     picker_localisation::RemovePicker::Response& res);
-  bool listPickers(picker_localisation::ListPickers::Request& req, picker_localisation::ListPickers::Response& res);
-  static constexpr int kMaxPredictionsPerCall = 100;  // a longer silence is bridged by one prediction
+  bool listPickers(picker_localisation::ListPickers::Request& req,
+                   picker_localisation::ListPickers::Response& res);
   static constexpr double kMaxWhatIfHorizon = 3600.0;  // s: a planner asks seconds to minutes ahead
-  // An exception out of a picker's filter (std::bad_alloc): logged, counted, that belief reset.
-  void caught(Track& t, const std::exception& e);
   void diagnoseFleet(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper& stat);
   // The clock jumped back (bag loop, simulator restart): every belief and the waiting observations are dropped
@@ -161,6 +155,7 @@ class TpfTracker {
   YAML::Node base_params_;
   int seed_param_ = 0;
   core::PickerRegistry registry_;
+  std::unique_ptr<tpf::TrackerFleet> fleet_;  // every picker's filter and the prediction schedule
   std::map<std::string, std::unique_ptr<Track>> tracks_;
   ros::Subscriber sub_;
   ros::Publisher registry_pub_;
