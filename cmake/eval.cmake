@@ -11,7 +11,8 @@ target_include_directories(picker_localisation_eval SYSTEM PUBLIC ${OpenCV_INCLU
 # The experiment runner drives the nodes' own core classes (simulator, front-ends, tracker fleet, planner).
 add_library(picker_localisation_experiment src/eval/experiment.cpp)
 target_link_libraries(picker_localisation_experiment PUBLIC picker_localisation_eval picker_localisation_sim
-  picker_localisation_tpf picker_localisation_vision picker_localisation_sensors_ranging picker_localisation_nbs)
+  picker_localisation_tpf picker_localisation_vision picker_localisation_sensors_ranging picker_localisation_nbs
+  picker_localisation_dispatch)
 target_compile_definitions(picker_localisation_experiment PRIVATE PL_EVAL_PACKAGE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")
 
 add_executable(experiment src/tools/experiment.cpp)

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -63,7 +64,11 @@ fs::path tempDir(const std::string& name) {
 }  // namespace
 
 TEST(Experiment, MethodsAndScenarios) {
-  EXPECT_EQ(allMethodNames().size(), 12u);
+  EXPECT_EQ(allMethodNames().size(), 13u);
+  EXPECT_TRUE(isKnownMethod("oracle"));
+  EXPECT_EQ(parseScenario("calls"), Scenario::kCalls);
+  EXPECT_EQ(defaultMethods(Scenario::kCalls),
+            (std::vector<std::string>{"oracle", "raw_fix", "khan_connected", "estimated_node", "nbs"}));
   EXPECT_TRUE(isKnownMethod("ukf_metric"));
   EXPECT_TRUE(isKnownMethod("raw_fix"));
   EXPECT_TRUE(isKnownMethod("gnss_tpf"));
@@ -241,4 +246,57 @@ TEST(Experiment, LidarPeopleTeachTheGnssBias) {
     EXPECT_GT(never_residual / never, fresh_residual / fresh);
   }
   EXPECT_GT(static_cast<double>(fresh_right) / fresh_lane, 0.85);
+}
+
+TEST(Experiment, CallsScenarioScoresEveryCall) {
+  // Six pickers fill trays in 60-180 s and call; two robots answer. With the true node (oracle) every call is
+  // answered, none falsely; the raw fix's node sends robots into lanes the picker is not in. summary.csv has
+  // the call columns.
+  const fs::path dir = tempDir("calls");
+  const std::string sim = (dir / "sim_calls.yaml").string();
+  {
+    YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
+    y["calls"]["tray_time_mean"] = 120.0;
+    std::ofstream(sim) << y;
+  }
+  ExperimentConfig c;
+  c.map_path = std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2";
+  c.scenario = Scenario::kCalls;
+  c.methods = {"oracle", "raw_fix"};
+  c.runs = 2;
+  c.duration = 900.0;
+  c.out_dir = dir.string();
+  c.jobs = 2;
+  c.run.pickers = 6;
+  c.run.robots = 2;
+  c.run.sim_config = sim;
+  std::ostringstream log;
+  runExperiment(c, log);
+  const std::string csv = slurp(dir / "summary.csv");
+  ASSERT_EQ(csv.rfind("method,calls,arrived,arrival_s_mean,arrival_ratio_oracle,wrong_lane_entries_per_call,"
+                      "false_arrivals",
+                      0),
+            0u)
+      << csv;
+  std::map<std::string, std::vector<std::string>> rows;
+  std::stringstream lines(csv);
+  std::string line;
+  std::getline(lines, line);
+  while (std::getline(lines, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    std::string cell;
+    while (std::getline(cs, cell, ',')) cells.push_back(cell);
+    rows[cells.at(0)] = cells;
+  }
+  ASSERT_EQ(rows.size(), 2u) << csv;
+  const auto& oracle = rows.at("oracle");
+  const auto& raw = rows.at("raw_fix");
+  EXPECT_GE(std::stoi(oracle[1]), 20);  // 6 pickers, 900 s, 2 runs: about 6 calls each
+  EXPECT_GE(std::stoi(oracle[2]),
+            std::stoi(oracle[1]) - 6);  // all but the last few of each run, still queued
+  EXPECT_EQ(std::stoi(oracle[6]), 0);   // no false arrival
+  EXPECT_DOUBLE_EQ(std::stod(oracle[4]), 1.0);
+  EXPECT_LT(std::stod(oracle[5]), 0.2);
+  EXPECT_GT(std::stod(raw[5]), std::stod(oracle[5]));  // the raw fix's node is often a lane off
 }

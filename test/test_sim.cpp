@@ -895,6 +895,45 @@ TEST(FarmSimulator, PickersAndGnssIndependentOfRobotsAndSensorSwitches) {
   for (std::size_t k = 0; k < fa.size(); ++k) EXPECT_EQ(fa[k].error, fb[k].error);
 }
 
+TEST(FarmSimulator, CallersStandStillUntilReleasedThenFillTheNextTrays) {
+  const auto map = topology::loadMap(kTmap2);
+  SimConfig c = quietConfig(5);
+  c.enable.camera = c.enable.laser = c.enable.uwb = false;
+  c.calls.enabled = true;
+  c.calls.tray_time_mean = 60.0;  // trays full after 30-90 s
+  c.calls.reported_row_share = 1.0;
+  c.calls.wrong_row_probability = 0.0;
+  FarmSimulator sim(map, c);
+  SimConfig off = quietConfig(5);
+  off.enable = c.enable;
+  FarmSimulator walking(map, off);  // calls off: the same walks as ever
+  std::vector<PickerCall> calls;
+  while (calls.empty() && sim.time() < 200.0) {
+    const auto out = sim.step(0.5);
+    walking.step(0.5);
+    calls = out.calls;
+    for (std::size_t i = 0; i < sim.numPickers() && calls.empty(); ++i)
+      EXPECT_EQ(sim.pickerPose(i).x, walking.pickerPose(i).x);  // before any call: the same walk
+  }
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_GE(calls[0].stamp, 30.0);
+  EXPECT_LE(calls[0].stamp, 90.0);
+  const std::size_t i = calls[0].picker_index;
+  EXPECT_EQ(calls[0].picker_id, sim.pickerSpec(i).id);
+  EXPECT_EQ(calls[0].reported_row, map.laneNameOf(sim.pickerNearestNode(i)));  // every call reports its row
+  EXPECT_TRUE(sim.pickerWaiting(i));
+  const Pose2D at = sim.pickerPose(i);
+  for (int k = 0; k < 60; ++k) {
+    for (const auto& again : sim.step(0.5).calls) EXPECT_NE(again.picker_index, i);  // one call at a time
+  }
+  EXPECT_EQ(sim.pickerPose(i).x, at.x);  // waited 30 s where it called
+  EXPECT_EQ(sim.pickerPose(i).y, at.y);
+  sim.releasePicker(i);
+  EXPECT_FALSE(sim.pickerWaiting(i));
+  sim.step(5.0);
+  EXPECT_GT((sim.pickerPose(i).position() - at.position()).norm(), 0.5);  // walks on
+}
+
 TEST(FarmSimulator, SensorRatesAndStamps) {
   const auto map = polytunnel(6, 8);
   SimConfig c = quietConfig(3);

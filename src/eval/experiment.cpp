@@ -23,6 +23,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "picker_localisation/dispatch/call_dispatcher.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 #include "picker_localisation/nbs/tpf_belief_source.h"
 #include "picker_localisation/sensors_ranging/gnss_fleet.h"
@@ -45,7 +46,9 @@ Scenario parseScenario(const std::string& name) {
   if (name == "single") return Scenario::kSingle;
   if (name == "navigation") return Scenario::kNavigation;
   if (name == "multi") return Scenario::kMulti;
-  throw std::invalid_argument("unknown scenario '" + name + "' (expected single, navigation or multi)");
+  if (name == "calls") return Scenario::kCalls;
+  throw std::invalid_argument("unknown scenario '" + name +
+                              "' (expected single, navigation, multi or calls)");
 }
 
 const char* toString(Scenario s) {
@@ -56,13 +59,15 @@ const char* toString(Scenario s) {
       return "navigation";
     case Scenario::kMulti:
       return "multi";
+    case Scenario::kCalls:
+      return "calls";
   }
   return "?";
 }
 
 namespace {
 
-enum class Tracker { kTpf, kUkf, kRawFix };
+enum class Tracker { kTpf, kUkf, kRawFix, kOracle };
 enum class RobotPolicy { kPatrol, kEstimatedNode, kNbs };
 
 // What a method is made of. The TPF preset names are TpfParams::presetForMethod's.
@@ -78,8 +83,8 @@ const std::vector<MethodSpec>& methodSpecs() {
   static const std::vector<MethodSpec> specs = {
       {"khan_connected", Tracker::kTpf, "khan_connected", true, false, false, RobotPolicy::kPatrol},
       {"khan_unconnected", Tracker::kTpf, "khan_unconnected", true, false, false, RobotPolicy::kPatrol},
-      // Not in Table II: the node nearest the latest accepted fix (no filter; Khan et al. Fig. 3c's reference),
-      // and the full TPF on GNSS alone.
+      // Not in Table II: the node nearest the latest accepted fix (no filter; Khan et al. Fig. 3c's
+      // reference), and the full TPF on GNSS alone.
       {"raw_fix", Tracker::kRawFix, "", true, false, false, RobotPolicy::kPatrol},
       {"gnss_tpf", Tracker::kTpf, "tpf", true, false, false, RobotPolicy::kPatrol},
       {"lidar_gnss", Tracker::kTpf, "tpf", true, true, false, RobotPolicy::kPatrol},
@@ -90,6 +95,8 @@ const std::vector<MethodSpec>& methodSpecs() {
       {"ukf_metric", Tracker::kUkf, "", true, true, false, RobotPolicy::kPatrol},
       {"no_monitor", Tracker::kTpf, "no_monitor", true, true, true, RobotPolicy::kPatrol},
       {"constant_speed", Tracker::kTpf, "constant_speed", true, true, true, RobotPolicy::kPatrol},
+      // Calls scenario: the dispatcher told the node the picker stands on (the limit of any estimate).
+      {"oracle", Tracker::kOracle, "", true, false, false, RobotPolicy::kPatrol},
   };
   return specs;
 }
@@ -105,8 +112,9 @@ std::string legModelPath(const RunConfig& config) {
                                   : config.leg_model;
 }
 
-std::size_t numPickers(Scenario s) {
-  return s == Scenario::kMulti ? 3 : 1;
+std::size_t numPickers(const RunConfig& config) {
+  if (config.scenario == Scenario::kCalls) return config.pickers;
+  return config.scenario == Scenario::kMulti ? 3 : 1;
 }
 
 }  // namespace
@@ -161,6 +169,8 @@ std::vector<std::string> defaultMethods(Scenario s) {
       return {"estimated_node", "nbs"};
     case Scenario::kMulti:
       return {"ukf_metric", "rfid_lidar_gnss", "no_monitor", "constant_speed"};
+    case Scenario::kCalls:
+      return {"oracle", "raw_fix", "khan_connected", "estimated_node", "nbs"};
   }
   return {};
 }
@@ -198,16 +208,17 @@ sim::SimConfig simConfigFor(const RunConfig& config, const MethodSpec& spec) {
   sim::SimConfig sc = sim_file.empty() ? sim::SimConfig() : sim::loadSimConfig(sim_file);
   if (!datum_file.empty()) sc.datum = core::GeodeticDatum::load(datum_file).config();
   sc.seed = config.seed;
-  const std::size_t n = numPickers(config.scenario);
+  const std::size_t n = numPickers(config);
   sc.pickers.clear();
   if (!pickers_file.empty()) {
     const auto specs = sim::pickerSpecsFromRegistry(core::PickerRegistry::load(pickers_file));
-    if (specs.size() < n)
+    if (specs.size() < n && config.scenario != Scenario::kCalls)
       throw std::runtime_error(pickers_file + ": scenario " + toString(config.scenario) + " needs " +
                                std::to_string(n) + " pickers");
-    sc.pickers.assign(specs.begin(), specs.begin() + static_cast<long>(n));
-  } else {
-    for (std::size_t i = 0; i < n; ++i) {
+    sc.pickers.assign(specs.begin(), specs.begin() + static_cast<long>(std::min(n, specs.size())));
+  }
+  if (sc.pickers.size() < n) {  // the calls scenario's farm: the file's pickers, then picker_<i> with tags
+    for (std::size_t i = sc.pickers.size(); i < n; ++i) {
       sim::PickerSpec p;
       p.id = "picker_" + std::to_string(i + 1);
       p.rfid_tag = "rfid_000" + std::to_string(i + 1);
@@ -221,6 +232,13 @@ sim::SimConfig simConfigFor(const RunConfig& config, const MethodSpec& spec) {
   sc.enable.gnss = spec.gnss;
   sc.enable.laser = spec.lidar;
   sc.enable.rfid = spec.rfid;
+  if (config.scenario == Scenario::kCalls) {
+    // Robots wait where they are until the dispatcher sends them; every robot reads RFID tags (arrival).
+    sc.num_robots = config.robots;
+    sc.robot_motion.patrol = sim::PatrolPolicy::kStay;
+    sc.calls.enabled = true;
+    sc.enable.rfid = true;
+  }
   sc.enable.uwb = false;
   sc.enable.camera = false;
   return sc;
@@ -238,10 +256,13 @@ class GraphRun {
   void onFix(const sim::GnssFixWithTruth& fix);
   void onRfid(const sim::RfidReadingWithTruth& read);
   void onScan(const sim::LaserScanWithTruth& scan);
+  void onCall(const sim::PickerCall& call);
   // The trackers' periodic predictions and the planner, at the end of a simulator step.
   void endOfStep(double now);
   // One error sample per picker with an estimate (scoring).
   void sample(double t);
+  // The calls scenario's calls still open at the end of the run: scored as not arrived.
+  void finish();
   RunResult& result() { return result_; }
 
  private:
@@ -254,8 +275,22 @@ class GraphRun {
     double restart = std::nan("");             // stamp of the first fix, or of the fix that ended a blackout
     double seen_after_restart = std::nan("");  // first accepted bias sighting after it
   };
+  // A call the dispatcher serves, scored from the simulator's truth.
+  struct OpenCall {
+    std::size_t picker = 0;
+    CallRecord record;
+    bool arrived = false, released = false;
+    std::size_t robot = 0;
+    NodeIndex robot_node = topology::kInvalidNode;   // the serving robot's current node at the last step
+    topology::LaneIndex inside = topology::kNoLane;  // the lane whose inner edge it drives along, if any
+    Eigen::Vector2d robot_at = Eigen::Vector2d::Zero();
+  };
   void publish(const core::Observation& obs);
   NodeIndex estimate(std::size_t picker) const;
+  void arrived(std::uint64_t call_id, std::size_t robot, double stamp);  // scoring an arrival
+  // The calls scenario at the end of a step: beliefs and robot nodes to the dispatcher, its goals to the
+  // robots, loaded pickers released, each open call scored.
+  void dispatchCalls(double now);
 
   std::shared_ptr<const topology::TopologicalMap> map_;
   RunConfig config_;
@@ -267,6 +302,8 @@ class GraphRun {
   std::unique_ptr<vision::LegPipeline> legs_;
   std::unique_ptr<tpf::TrackerFleet> trackers_;  // Tracker::kTpf
   UkfMetricTracker ukf_;                         // Tracker::kUkf
+  std::unique_ptr<dispatch::CallDispatcher> dispatcher_;  // Scenario::kCalls
+  std::map<std::uint64_t, OpenCall> open_calls_;
   std::unique_ptr<nbs::NextBestSensePlanner> planner_;
   std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources_;
   double replan_period_ = 0.0, battery_level_ = 1.0, last_plan_ = -1e300;
@@ -317,7 +354,25 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
         throw std::runtime_error("tracker of " + scoring_[i].id + ": " + error);
     }
   }
-  if (spec_.policy != RobotPolicy::kPatrol) {
+  if (config.scenario == Scenario::kCalls) {
+    if (spec_.tracker == Tracker::kUkf)
+      throw std::runtime_error("the calls scenario has no ukf_metric dispatch");
+    const std::string file = resolveConfigFile(config.dispatcher_config, "dispatcher.yaml");
+    dispatch::DispatcherOptions o = file.empty()
+                                        ? dispatch::DispatcherOptions()
+                                        : dispatch::DispatcherOptions::fromYaml(YAML::LoadFile(file));
+    if (o.storage_node.empty()) {  // this map's: the node outside the lanes nearest its lower-left corner
+      const topology::BoundingBox box = map_->boundingBox();
+      double best = 1e300;
+      for (NodeIndex n = 0; n < map_->numNodes(); ++n) {
+        const double d = (map_->position2d(n) - Eigen::Vector2d(box.min_x, box.min_y)).norm();
+        if (map_->lane(n) == topology::kNoLane && d < best) best = d, o.storage_node = map_->node(n).name;
+      }
+    }
+    std::vector<std::string> robot_ids;
+    for (std::size_t r = 0; r < simulator_.numRobots(); ++r) robot_ids.push_back(simulator_.robot(r).id());
+    dispatcher_ = std::make_unique<dispatch::CallDispatcher>(map_, o, robot_ids);
+  } else if (spec_.policy != RobotPolicy::kPatrol) {
     // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
     // what_if_seed); the method sets the policy.
     const std::string nbs_file = resolveConfigFile(config.nbs_config, "nbs.yaml");
@@ -374,6 +429,13 @@ void GraphRun::onRfid(const sim::RfidReadingWithTruth& rr) {
     const std::size_t before = gnss_->counters().sightings;
     publish(*r.observation);
     result_.bias_sightings += gnss_->counters().sightings - before;
+    // The serving robot read the caller's tag: arrival (the robot's own sensing, never the truth).
+    const std::string& robot_id = simulator_.robot(rr.robot_index).id();
+    if (dispatcher_ && r.observation->identifying) {
+      const dispatch::Call* served = dispatcher_->servedBy(robot_id);
+      if (served && dispatcher_->rfidRead(robot_id, r.observation->picker_id, rr.stamp, rr.rssi))
+        arrived(served->id, rr.robot_index, rr.stamp);
+    }
   }
   for (const auto& neg : r.negative) publish(neg);
 }
@@ -394,6 +456,12 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
     // Identity for the anonymous people, as gnss_ingest gives it.
     const sensors::AssociationResult a =
         gnss_->associate(vision::LegPipeline::observation(t, *map_, s.stamp, s.robot_id));
+    if (a.picker >= 0 && dispatcher_) {  // the serving robot's own identified person: arrival when near
+      const dispatch::Call* served = dispatcher_->servedBy(s.robot_id);
+      const double d = (t.position - simulator_.robotPose(s.robot_index).position()).norm();
+      if (served && dispatcher_->sighting(s.robot_id, a.observation.picker_id, s.stamp, d))
+        arrived(served->id, s.robot_index, s.stamp);
+    }
     if (a.picker >= 0) {
       ++result_.identified_detections;
       std::size_t nearest = 0;
@@ -420,8 +488,92 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
   if (!people.empty()) ukf_.addDetections(s.stamp, people);
 }
 
+void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp) {
+  OpenCall& c = open_calls_.at(call_id);
+  c.arrived = true;
+  c.record.arrival_s = stamp - c.record.stamp;
+  c.record.false_arrival =
+      (simulator_.robotPose(robot).position() - simulator_.pickerPose(c.picker).position()).norm() > 3.0;
+}
+
+void GraphRun::onCall(const sim::PickerCall& call) {
+  if (!dispatcher_) return;
+  std::string error;
+  const auto id = dispatcher_->call(call.picker_id, call.stamp, &error);
+  if (!id) throw std::runtime_error("call of " + call.picker_id + " refused: " + error);
+  OpenCall c;
+  c.picker = call.picker_index;
+  c.record.picker_id = call.picker_id;
+  c.record.stamp = call.stamp;
+  c.record.arrival_s = std::numeric_limits<double>::infinity();
+  c.record.reported_row = !call.reported_row.empty();
+  open_calls_[*id] = c;
+}
+
+void GraphRun::dispatchCalls(double now) {
+  for (const auto& [id, c] : open_calls_) {
+    const std::string& picker_id = c.record.picker_id;
+    const NodeIndex est = estimate(c.picker);
+    if (spec_.tracker == Tracker::kTpf && spec_.policy != RobotPolicy::kEstimatedNode) {
+      const tpf::TopologicalParticleFilter& f = *trackers_->find(picker_id)->filter;
+      if (f.initialised()) dispatcher_->setBelief(picker_id, f.belief().nodes, f.belief().masses);
+    } else if (est != topology::kInvalidNode) {
+      dispatcher_->setBelief(picker_id, {est},
+                             {1.0});  // one node: the oracle's, the raw fix's or the MAP node
+    }
+  }
+  for (std::size_t r = 0; r < simulator_.numRobots(); ++r)
+    dispatcher_->setRobotNode(simulator_.robot(r).id(), simulator_.robot(r).currentNode());
+  for (const dispatch::Goal& g : dispatcher_->update(now)) {
+    const std::size_t r = *simulator_.robotIndex(g.robot_id);
+    simulator_.setRobotGoal(r, g.node);
+    OpenCall& c = open_calls_.at(g.call_id);
+    if (g.state == dispatch::CallState::kAssigned) {  // the robot starts serving: scoring starts
+      c.robot = r;
+      c.robot_at = simulator_.robotPose(r).position();
+      c.robot_node = simulator_.robot(r).currentNode();
+    }
+  }
+  for (auto it = open_calls_.begin(); it != open_calls_.end();) {
+    OpenCall& c = it->second;
+    const dispatch::Call& call = *dispatcher_->find(it->first);
+    if (!call.robot_id.empty() && !c.arrived) {  // on its way: metres and lanes entered
+      const Eigen::Vector2d at = simulator_.robotPose(c.robot).position();
+      c.record.metres += (at - c.robot_at).norm();
+      c.robot_at = at;
+      // Driving into a lane: along an edge whose two nodes are in that lane (passing a lane's end on the
+      // headland is not entering it).
+      const NodeIndex node = simulator_.robot(c.robot).currentNode();
+      if (node != c.robot_node) {
+        const topology::LaneIndex lane =
+            map_->lane(node) == map_->lane(c.robot_node) ? map_->lane(node) : topology::kNoLane;
+        if (lane != c.inside && lane != topology::kNoLane && lane != simulator_.pickerLane(c.picker))
+          ++c.record.wrong_lane_entries;
+        c.inside = lane;
+        c.robot_node = node;
+      }
+    }
+    if (!c.released && (call.state == dispatch::CallState::kToStorage || !call.open())) {
+      simulator_.releasePicker(c.picker);  // the trays were loaded: the picker walks on
+      c.released = true;
+    }
+    if (!call.open()) {
+      result_.calls.push_back(c.record);
+      it = open_calls_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+void GraphRun::finish() {
+  for (const auto& [id, c] : open_calls_) result_.calls.push_back(c.record);
+  open_calls_.clear();
+}
+
 void GraphRun::endOfStep(double now) {
   if (trackers_) trackers_->predictDue(now);
+  if (dispatcher_) dispatchCalls(now);
   if (!planner_ || !(simulator_.robot(0).atGoal() || now - last_plan_ >= replan_period_)) return;
   std::vector<nbs::BeliefSource*> views;
   for (std::size_t i = 0; i < sources_.size(); ++i) {
@@ -446,6 +598,8 @@ NodeIndex GraphRun::estimate(std::size_t i) const {
     }
     case Tracker::kRawFix:
       return scoring_[i].raw_fix_node;
+    case Tracker::kOracle:
+      return simulator_.pickerNearestNode(i);
   }
   return topology::kInvalidNode;
 }
@@ -502,6 +656,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) {
       return a.stamp != b.stamp ? a.stamp < b.stamp : a.kind < b.kind;
     });
+    for (const sim::PickerCall& call : out.calls) run.onCall(call);
     for (const Event& e : events) {
       if (e.kind == 0) run.onFix(out.gnss[e.index]);
       if (e.kind == 1) run.onRfid(out.rfid[e.index]);
@@ -511,6 +666,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     for (; next_sample <= simulator.time() + 1e-9; next_sample += config.sample_period)
       run.sample(next_sample);
   }
+  run.finish();
   RunResult result = std::move(run.result());
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
@@ -553,6 +709,63 @@ void writeBiasByAge(const std::string& path, const std::vector<RunResult>& runs,
   log << "\n";
 }
 
+// The calls scenario's table, one row per method: what the farm feels of a call.
+struct CallSummary {
+  std::string method;
+  std::size_t calls = 0, arrived = 0, false_arrivals = 0, reported_row = 0;
+  double arrival_s_mean = 0.0, wrong_lane_entries_per_call = 0.0, metres_mean = 0.0, right_lane_share = 0.0;
+};
+
+CallSummary summariseCalls(const std::string& method, const std::vector<RunResult>& runs, double right_lane) {
+  CallSummary s;
+  s.method = method;
+  s.right_lane_share = right_lane;
+  double arrival = 0.0, wrong = 0.0, metres = 0.0;
+  for (const RunResult& r : runs)
+    for (const CallRecord& c : r.calls) {
+      ++s.calls;
+      wrong += static_cast<double>(c.wrong_lane_entries);
+      metres += c.metres;
+      s.false_arrivals += c.false_arrival ? 1 : 0;
+      s.reported_row += c.reported_row ? 1 : 0;
+      if (std::isfinite(c.arrival_s)) {
+        ++s.arrived;
+        arrival += c.arrival_s;
+      }
+    }
+  s.arrival_s_mean = s.arrived ? arrival / static_cast<double>(s.arrived) : std::nan("");
+  s.wrong_lane_entries_per_call = s.calls ? wrong / static_cast<double>(s.calls) : std::nan("");
+  s.metres_mean = s.calls ? metres / static_cast<double>(s.calls) : std::nan("");
+  return s;
+}
+
+// summary.csv and summary.md of the calls scenario (arrival_ratio_oracle: against the oracle row, when run).
+void writeCallSummaries(const std::string& dir, const std::string& title,
+                        const std::vector<CallSummary>& rows) {
+  double oracle = std::nan("");
+  for (const CallSummary& s : rows)
+    if (s.method == "oracle") oracle = s.arrival_s_mean;
+  std::ofstream csv(dir + "/summary.csv"), md(dir + "/summary.md");
+  csv << "method,calls,arrived,arrival_s_mean,arrival_ratio_oracle,wrong_lane_entries_per_call,false_"
+         "arrivals,"
+         "metres_per_call,right_lane_share,calls_with_reported_row\n";
+  md << "### " << title
+     << "\n\n| method | calls | arrived | call-to-arrival [s] | vs oracle | wrong-lane entries per call "
+        "| false arrivals | metres per call | right-lane share |\n|---|---|---|---|---|---|---|---|---|\n";
+  for (const CallSummary& s : rows) {
+    const double ratio = s.arrival_s_mean / oracle;
+    csv << s.method << "," << s.calls << "," << s.arrived << "," << s.arrival_s_mean << "," << ratio << ","
+        << s.wrong_lane_entries_per_call << "," << s.false_arrivals << "," << s.metres_mean << ","
+        << s.right_lane_share << "," << s.reported_row << "\n";
+    md << std::fixed << "| " << s.method << " | " << s.calls << " | " << s.arrived << " | "
+       << std::setprecision(1) << s.arrival_s_mean << " | " << std::setprecision(2) << ratio << "x | "
+       << std::setprecision(3) << s.wrong_lane_entries_per_call << " | " << s.false_arrivals << " | "
+       << std::setprecision(1) << s.metres_mean << " | " << std::setprecision(3) << s.right_lane_share
+       << " |\n"
+       << std::defaultfloat;
+  }
+}
+
 // Keys of the configuration files the runs read that their schemas do not know (typos), logged once here as
 // the nodes warn at start-up; a bad value is left to the runs, which report it per run.
 void logUnknownKeys(const RunConfig& config, std::ostream& log) {
@@ -590,6 +803,7 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
       << " lanes), scenario " << toString(config.scenario) << ", " << config.runs << " runs, seed "
       << config.seed << ", " << config.duration << " s simulated, " << config.jobs << " job(s)\n";
   logUnknownKeys(config.run, log);
+  std::vector<CallSummary> call_rows;
   for (const auto& method : methods) {
     RunConfig rc = config.run;
     rc.scenario = config.scenario;
@@ -627,6 +841,13 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
 
     fs::create_directories(fs::path(config.out_dir) / method);
     std::vector<std::vector<ErrorSample>> samples;
+    for (std::size_t k = 0; k < config.runs && config.scenario == Scenario::kCalls; ++k) {
+      std::ofstream calls(fs::path(config.out_dir) / method / ("calls_" + std::to_string(k) + ".csv"));
+      calls << "picker_id,stamp,arrival_s,wrong_lane_entries,false_arrival,metres,reported_row\n";
+      for (const CallRecord& c : runs[k].calls)
+        calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
+              << c.false_arrival << "," << c.metres << "," << c.reported_row << "\n";
+    }
     for (std::size_t k = 0; k < config.runs; ++k) {
       writeRunCsv((fs::path(config.out_dir) / method / ("run_" + std::to_string(k) + ".csv")).string(), *map,
                   runs[k].samples);
@@ -634,6 +855,14 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     }
     MethodSummary row = summariseMethod(method, samples);
     res.rows.push_back(row);
+    if (config.scenario == Scenario::kCalls) {
+      call_rows.push_back(summariseCalls(method, runs, row.right_lane_share));
+      const CallSummary& c = call_rows.back();
+      log << "    calls " << c.calls << ", arrived " << c.arrived << ", call-to-arrival " << std::fixed
+          << std::setprecision(1) << c.arrival_s_mean << " s, wrong-lane entries per call "
+          << std::setprecision(3) << c.wrong_lane_entries_per_call << ", false arrivals " << c.false_arrivals
+          << ", metres per call " << std::setprecision(1) << c.metres_mean << std::defaultfloat << "\n";
+    }
     res.series.push_back(binErrors(method, samples, 0.0, std::max(5.0, config.duration / 100.0)));
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
     log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean
@@ -664,12 +893,18 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
       writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
     }
   }
-  writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
   std::ostringstream title;
-  title << "Table II, scenario " << toString(config.scenario) << ": map " << map->name() << ", "
-        << config.runs << " runs, seeds " << config.seed << ".." << config.seed + config.runs - 1 << ", "
-        << config.duration << " s simulated";
-  writeSummaryMarkdown((fs::path(config.out_dir) / "summary.md").string(), title.str(), res.rows);
+  title << (config.scenario == Scenario::kCalls ? "Calls" : "Table II") << ", scenario "
+        << toString(config.scenario) << ": map " << map->name() << ", " << config.runs << " runs, seeds "
+        << config.seed << ".." << config.seed + config.runs - 1 << ", " << config.duration << " s simulated";
+  if (config.scenario == Scenario::kCalls) {
+    title << ", " << config.run.pickers << " pickers, " << config.run.robots << " robots";
+    writeCallSummaries(config.out_dir, title.str(), call_rows);
+    writeSummaryCsv((fs::path(config.out_dir) / "errors_summary.csv").string(), res.rows);
+  } else {
+    writeSummaryCsv((fs::path(config.out_dir) / "summary.csv").string(), res.rows);
+    writeSummaryMarkdown((fs::path(config.out_dir) / "summary.md").string(), title.str(), res.rows);
+  }
   if (!res.series.empty()) plotErrors((fs::path(config.out_dir) / "errors.png").string(), res.series);
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   log << "experiment: wrote " << config.out_dir << "/summary.csv, summary.md"

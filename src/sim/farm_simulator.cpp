@@ -33,6 +33,7 @@ enum Stream : std::uint64_t {
   kUwb = 6000,
   kCamera = 7000,
   kWaypoints = 8000,
+  kTrays = 9000,
 };
 constexpr std::uint64_t kStreamStride = 1ULL << 32;  // streams = base * stride + index
 std::uint64_t streamId(Stream s, std::size_t i) {
@@ -103,6 +104,10 @@ FarmSimulator::FarmSimulator(const topology::TopologicalMap& map, SimConfig conf
     pickers_.emplace_back(map, std::move(tour), config_.picker_motion,
                           deriveSeed(seed, streamId(kPickerMotion, i)), 0.0);
     gnss_.emplace_back(config_.gnss, deriveSeed(seed, streamId(kGnss, i)), 0.0);
+    tray_rng_.emplace_back(deriveSeed(seed, streamId(kTrays, i)));
+    waiting_.push_back(false);
+    tray_full_at_.push_back(std::uniform_real_distribution<double>(0.5, 1.5)(tray_rng_.back()) *
+                            config_.calls.tray_time_mean);
   }
 
   // Robots.
@@ -198,7 +203,8 @@ SimOutputs FarmSimulator::advanceTo(double t) {
 }
 
 void FarmSimulator::internalStep(double dt) {
-  for (auto& p : pickers_) p.step(dt);
+  for (std::size_t i = 0; i < pickers_.size(); ++i)
+    if (!waiting_[i]) pickers_[i].step(dt);  // a picker who called stands where it is
   for (auto& r : robots_) r.step(dt);
   time_ += dt;
 }
@@ -260,7 +266,40 @@ double distance3d(const Eigen::Vector2d& a, double za, const Eigen::Vector2d& b,
 }
 }  // namespace
 
+void FarmSimulator::releasePicker(std::size_t i) {
+  if (!waiting_.at(i)) return;
+  waiting_[i] = false;
+  tray_full_at_[i] =
+      time_ + std::uniform_real_distribution<double>(0.5, 1.5)(tray_rng_[i]) * config_.calls.tray_time_mean;
+}
+
+void FarmSimulator::callWhenTraysFull(SimOutputs& out) {
+  if (!config_.calls.enabled) return;
+  for (std::size_t i = 0; i < pickers_.size(); ++i) {
+    if (waiting_[i] || time_ < tray_full_at_[i]) continue;
+    waiting_[i] = true;
+    PickerCall call;
+    call.stamp = time_;
+    call.picker_index = i;
+    call.picker_id = config_.pickers[i].id;
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const topology::LaneIndex lane = pickerLane(i);
+    if (u(tray_rng_[i]) < config_.calls.reported_row_share && lane != topology::kNoLane) {
+      topology::LaneIndex reported = lane;
+      if (u(tray_rng_[i]) < config_.calls.wrong_row_probability && map_->numLanes() > 1) {
+        // A neighbouring lane (by index; lanes of one tunnel are numbered side by side).
+        const bool down = lane > 0 && (lane + 1 >= static_cast<topology::LaneIndex>(map_->numLanes()) ||
+                                       u(tray_rng_[i]) < 0.5);
+        reported = down ? lane - 1 : lane + 1;
+      }
+      call.reported_row = map_->laneName(reported);
+    }
+    out.calls.push_back(std::move(call));
+  }
+}
+
 void FarmSimulator::fireSensors(SimOutputs& out) {
+  callWhenTraysFull(out);
   const auto& en = config_.enable;
   const auto& layout = config_.sensor_layout;
   onTicks(gnss_tick_, config_.gnss.rate, time_, [&](double stamp) {

@@ -143,6 +143,11 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                            {"post_radius", set(c.clutter.post_radius)},
                            {"merge_distance", set(c.clutter.merge_distance)}},
                           "clutter")},
+      {"calls", section({{"enabled", set(c.calls.enabled)},
+                         {"tray_time_mean", set(c.calls.tray_time_mean)},
+                         {"reported_row_share", set(c.calls.reported_row_share)},
+                         {"wrong_row_probability", set(c.calls.wrong_row_probability)}},
+                        "calls")},
       {"enable", section({{"gnss", set(c.enable.gnss)},
                           {"laser", set(c.enable.laser)},
                           {"rfid", set(c.enable.rfid)},
@@ -156,6 +161,12 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
     throw std::runtime_error(source + ": picker_motion.long_stop_probability must be in [0, 1]");
   if (!(m.long_stop_mean > 0.0))
     throw std::runtime_error(source + ": picker_motion.long_stop_mean must be > 0");
+  if (!(c.calls.tray_time_mean > 0.0))
+    throw std::runtime_error(source + ": calls.tray_time_mean must be > 0");
+  for (double p : {c.calls.reported_row_share, c.calls.wrong_row_probability})
+    if (!(p >= 0.0 && p <= 1.0))
+      throw std::runtime_error(source +
+                               ": calls.reported_row_share and wrong_row_probability must be in [0, 1]");
 }
 
 SimConfig loadSimConfig(const std::string& path) {

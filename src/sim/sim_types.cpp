@@ -30,6 +30,7 @@ void moveAppend(std::vector<T>& to, std::vector<T>& from) {
 }  // namespace
 
 void SimOutputs::clear() {
+  calls.clear();
   gnss.clear();
   scans.clear();
   rfid.clear();
@@ -38,6 +39,7 @@ void SimOutputs::clear() {
 }
 
 void SimOutputs::append(SimOutputs&& other) {
+  moveAppend(calls, other.calls);
   moveAppend(gnss, other.gnss);
   moveAppend(scans, other.scans);
   moveAppend(rfid, other.rfid);

@@ -16,11 +16,13 @@
 namespace {
 
 void usage(std::ostream& o) {
-  o << "usage: experiment --map FILE --scenario single|navigation|multi [--methods M1,M2,...] [--runs N]\n"
+  o << "usage: experiment --map FILE --scenario single|navigation|multi|calls [--methods M1,M2,...] [--runs "
+       "N]\n"
        "                  [--seed S] [--duration SEC] --out DIR [--jobs J] [--sample-period SEC]\n"
        "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
        "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--nbs-config FILE]\n"
        "                  [--vision-config FILE[,FILE...]] [--tracker-seed N]\n"
+       "                  [--pickers-count N] [--robots K] [--dispatcher-config FILE]   (scenario calls)\n"
        "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in "
        "defaults\n"
        "methods:";
@@ -90,6 +92,12 @@ int main(int argc, char** argv) {
         cfg.run.vision_config = v;
       else if (a == "--tracker-seed")
         cfg.run.tracker_seed = std::stoull(v);
+      else if (a == "--pickers-count")
+        cfg.run.pickers = std::stoul(v);
+      else if (a == "--robots")
+        cfg.run.robots = std::stoul(v);
+      else if (a == "--dispatcher-config")
+        cfg.run.dispatcher_config = v;
       else
         throw std::invalid_argument("unknown option " + a);
     }

@@ -8,6 +8,9 @@
 //   single      1 picker, 1 robot  (Table II "Single picker")
 //   navigation  1 picker, 1 robot  (Table II "Navigation Strategy")
 //   multi       3 pickers, 1 robot (Table II "Multiple pickers")
+//   calls       `pickers` pickers fill trays and call, `robots` robots answer (dispatch::CallDispatcher);
+//   scored
+//               per call: call-to-arrival time, wrong-lane entries, false arrivals, metres driven
 // The robot patrols the lanes (simulator patrol `lanes`) unless the method is a navigation policy
 // (estimated_node, nbs), whose planner then sets the robot's goals.
 // A method whose components are not in this build (or whose data file is missing) is reported unavailable
@@ -27,7 +30,7 @@
 namespace picker_localisation {
 namespace eval {
 
-enum class Scenario { kSingle, kNavigation, kMulti };
+enum class Scenario { kSingle, kNavigation, kMulti, kCalls };
 Scenario parseScenario(const std::string& name);  // throws std::invalid_argument
 const char* toString(Scenario s);
 
@@ -59,6 +62,9 @@ struct RunConfig {
   std::string vision_config;       // leg_detector section (vision::LegPipelineOptions, as the node): "" =
                                   // config/vision.yaml, then the simulated-laser overlay config/vision_sim.yaml
                                   // (leg_threshold 0.42 = 0.3 at 0.5 deg); else comma-separated files applied in order
+  std::size_t pickers = 30;        // calls scenario: pickers (ids picker_<i>; config/pickers.yaml's first)
+  std::size_t robots = 10;         // calls scenario: robots (about 1 robot : 3 pickers)
+  std::string dispatcher_config;   // calls scenario: dispatch::DispatcherOptions, config/dispatcher.yaml
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else each from its picker id mixed with
                                    // this, as tpf_tracker with ~seed (tpf::TrackerFleet::seedFor)
 };
@@ -80,7 +86,19 @@ struct BiasSample {
   bool lane_applicable = false, in_true_lane = false;  // as the ErrorSample of the same instant
 };
 
+// One call of the calls scenario, scored from the simulator's truth.
+struct CallRecord {
+  std::string picker_id;
+  double stamp = 0.0;                  // s, when the picker called
+  double arrival_s = 0.0;              // s from the call to the arrival (+inf: not arrived by the run's end)
+  std::size_t wrong_lane_entries = 0;  // lanes the serving robot drove into that the picker was not in
+  bool false_arrival = false;          // arrival declared with the picker more than 3 m from the robot
+  double metres = 0.0;                 // driven by the serving robot from assignment to arrival
+  bool reported_row = false;           // the call carried a reported row
+};
+
 struct RunResult {
+  std::vector<CallRecord> calls;  // calls scenario
   std::vector<ErrorSample> samples;
   std::vector<BiasSample> bias_samples;
   std::size_t observations = 0;  // observations given to trackers

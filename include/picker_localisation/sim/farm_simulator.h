@@ -25,6 +25,7 @@
 
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,16 @@ struct SensorSwitches {
   bool camera = true;
 };
 
+// The call scenario: each picker fills trays (tray_time_mean s each on average, drawn uniformly in
+// [0.5, 1.5] x the mean from the picker's own generator) and, when they are full, calls a robot and stands
+// where it is until releasePicker (the trays were loaded). Off by default: pickers walk without stopping.
+struct CallParams {
+  bool enabled = false;
+  double tray_time_mean = 360.0;       // s (about 6 min on real farms)
+  double reported_row_share = 0.0;     // share of calls that carry the row the picker reports
+  double wrong_row_probability = 0.1;  // a reported row is a neighbouring lane's with this probability
+};
+
 struct SimConfig {
   std::uint64_t seed = 1;
   double time_step = 0.05;          // s, internal integration step
@@ -72,6 +83,7 @@ struct SimConfig {
   CameraParams camera;
   ClutterParams clutter;
   SensorSwitches enable;
+  CallParams calls;
 };
 
 // Overrides the fields present in a YAML mapping shaped like config/sim.yaml (sections seed, time_step,
@@ -118,6 +130,10 @@ class FarmSimulator {
   const SimulatedRobot& robot(std::size_t r) const { return robots_.at(r); }
   const Pose2D& robotPose(std::size_t r) const { return robots_.at(r).pose(); }
   std::optional<std::size_t> robotIndex(const std::string& id) const;
+  // The call scenario: whether picker i waits for a robot (it called), and the end of that wait (the trays
+  // were loaded): it walks on and fills its next trays. Throws std::out_of_range on a bad index.
+  bool pickerWaiting(std::size_t i) const { return waiting_.at(i); }
+  void releasePicker(std::size_t i);
   // Retargets robot r to a goal node (any time). Throws std::out_of_range on a bad index or node.
   void setRobotGoal(std::size_t r, topology::NodeIndex goal);
   void clearRobotGoal(std::size_t r);
@@ -130,6 +146,7 @@ class FarmSimulator {
  private:
   void internalStep(double dt);
   void fireSensors(SimOutputs& out);
+  void callWhenTraysFull(SimOutputs& out);
   void buildPosts();
 
   const topology::TopologicalMap* map_;
@@ -139,6 +156,9 @@ class FarmSimulator {
   double time_ = 0.0;
   std::vector<SimulatedPicker> pickers_;
   std::vector<GnssErrorModel> gnss_;
+  std::vector<bool> waiting_;              // the call scenario: picker i called and waits
+  std::vector<double> tray_full_at_;       // s: when picker i's trays are full next
+  std::vector<std::mt19937_64> tray_rng_;  // per picker: tray times and reported rows
   std::vector<SimulatedRobot> robots_;
   std::vector<Circle> posts_;
   struct SensorStreams;

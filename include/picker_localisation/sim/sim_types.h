@@ -94,7 +94,17 @@ struct CameraFrame {
 };
 
 // Everything the simulator produced during one step (or one advanceTo), in time order per sensor.
+// A picker whose trays are full calls a robot (the call scenario, SimConfig::calls) and waits where it
+// stands.
+struct PickerCall {
+  double stamp = 0.0;
+  std::size_t picker_index = 0;
+  std::string picker_id;
+  std::string reported_row;  // the lane the picker says it is in ("" none); sometimes a wrong one
+};
+
 struct SimOutputs {
+  std::vector<PickerCall> calls;
   std::vector<GnssFixWithTruth> gnss;
   std::vector<LaserScanWithTruth> scans;
   std::vector<RfidReadingWithTruth> rfid;
