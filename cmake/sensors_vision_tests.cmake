@@ -27,7 +27,7 @@ add_test(NAME vision_tools_cli
   COMMAND ${CMAKE_CURRENT_SOURCE_DIR}/test/check_vision_tools.sh $<TARGET_FILE:bag_detect_legs>
           $<TARGET_FILE:detect_people> ${CMAKE_CURRENT_SOURCE_DIR} ${PL_TEST_DATA})
 add_dependencies(tests bag_detect_legs detect_people)
-# rostest: the leg_detector node and the offline runner's LegPipeline give identical observations (issue 16).
+# rostest: the leg_detector node and the offline runner's LegPipeline give identical observations.
 if(TARGET picker_localisation_experiment)
   add_rostest_gtest(test_leg_pipeline_parity test/leg_pipeline_parity.test test/test_leg_pipeline_parity.cpp)
   target_link_libraries(test_leg_pipeline_parity picker_localisation_vision_ros picker_localisation_experiment)

@@ -35,7 +35,7 @@ for _ in $(seq 120); do [ -f "$work/out1.bag" ] && [ -f "$work/out2.bag" ] && br
 "$here/compare_replays.py" "$work/out1.bag" "$work/out2.bag" "$work/errors1.csv" "$work/errors2.csv" || exit 1
 # The same bag played in a loop (rosbag play -l): at each start the clock jumps back 70 s. Every node must notice
 # once per loop, reset its time state and carry on: beliefs, observations of every sensor and error samples
-# continue on the new time line (before issue 17, gnss_ingest and the trackers froze until the stamps overtook
+# continue on the new time line (before clock jumps were handled, gnss_ingest and the trackers froze until the stamps overtook
 # the old ones: forever, for a looping bag).
 echo "== looped replay (rate 4, ~2.5 passes) =="
 port=$((20000 + RANDOM % 20000))

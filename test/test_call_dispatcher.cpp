@@ -91,9 +91,9 @@ TEST(CallDispatcher, ArrivalOnlyFromTheServingRobotsOwnSightingThenLoadingStorag
   d.update(20.0);
   EXPECT_EQ(d.find(id)->state, CallState::kOnTheWay);
   EXPECT_FALSE(d.sighting("robot_2", "picker_1", 21.0, 0.5));  // another robot's sighting
-  EXPECT_FALSE(d.sighting("robot_1", "picker_1", 21.0, 2.5));  // too far (arrival_distance 2 m)
+  EXPECT_FALSE(d.sighting("robot_1", "picker_1", 21.0, 2.5));  // too far (arrival_distance 1.5 m here)
   EXPECT_FALSE(d.sighting("robot_1", "picker_2", 21.0, 0.5));  // another picker
-  EXPECT_TRUE(d.sighting("robot_1", "picker_1", 22.0, 1.9));
+  EXPECT_TRUE(d.sighting("robot_1", "picker_1", 22.0, 1.4));
   EXPECT_EQ(d.find(id)->state, CallState::kArrived);
   EXPECT_DOUBLE_EQ(d.find(id)->arrived_at, 22.0);
   EXPECT_TRUE(d.update(51.9).empty());  // loading: 30 s
@@ -158,14 +158,18 @@ TEST(CallDispatcher, OptionsFromYamlAndValidation) {
 
 TEST(CallDispatcher, AnRfidReadIsArrivalOnlyWhenStrong) {
   auto map = polytunnel();
-  CallDispatcher d(map, options(), {"robot_1"});  // arrival_min_rssi -50 dBm
+  DispatcherOptions o = options();  // arrival_min_rssi -48 dBm
+  o.arrival_by_lidar = false;
+  CallDispatcher d(map, o, {"robot_1"});
   d.setRobotNode("robot_1", node(*map, "H2"));
   d.setBelief("picker_1", {node(*map, "r2_4")}, {1});
   const auto id = *d.call("picker_1", 0.0);
   d.update(0.0);
   EXPECT_FALSE(d.rfidRead("robot_1", "picker_1", 5.0, -58.0));  // read at ~4 m: not there yet
+  EXPECT_FALSE(d.lidarPerson("robot_1", "picker_1", 6.0, 1.0));  // LiDAR identity switched off
   EXPECT_EQ(d.find(id)->state, CallState::kAssigned);
-  EXPECT_TRUE(d.rfidRead("robot_1", "picker_1", 9.0, -49.0));
+  EXPECT_FALSE(d.rfidRead("robot_1", "picker_1", 8.0, -49.0));
+  EXPECT_TRUE(d.rfidRead("robot_1", "picker_1", 9.0, -47.5));
   EXPECT_EQ(d.find(id)->state, CallState::kArrived);
 }
 
@@ -198,4 +202,16 @@ TEST(CallDispatcher, WithACommitShareTheRobotWaitsAtTheLaneEndUntilTheBeliefComm
   ASSERT_FALSE(goals.empty());
   EXPECT_EQ(goals.back().node, node(*map, "r4_6"));
   EXPECT_EQ(d.find(id)->robot_id, "robot_1");
+}
+
+TEST(CallDispatcher, AnIdentifiedLidarPersonNearTheRobotIsArrival) {
+  auto map = polytunnel();
+  CallDispatcher d(map, options(), {"robot_1"});
+  d.setRobotNode("robot_1", node(*map, "H2"));
+  d.setBelief("picker_1", {node(*map, "r2_4")}, {1});
+  const auto id = *d.call("picker_1", 0.0);
+  d.update(0.0);
+  EXPECT_FALSE(d.lidarPerson("robot_1", "picker_1", 6.0, 1.6));  // beyond arrival_distance (1.5 m)
+  EXPECT_TRUE(d.lidarPerson("robot_1", "picker_1", 7.0, 1.4));
+  EXPECT_EQ(d.find(id)->state, CallState::kArrived);
 }

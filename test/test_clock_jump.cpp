@@ -1,7 +1,7 @@
 // rostest: /clock runs 100 -> 112 s with a fix per second, then jumps back to 10 s and runs on with fixes
-// stamped 10.. s. Before issue 17's fix gnss_ingest rejected every later fix as "not after the last accepted one"
-// and the tracker dropped every observation as too old, so beliefs stopped; now both reset once and beliefs
-// stamped after the jump appear.
+// stamped 10.. s. Before clock jumps were handled gnss_ingest rejected every later fix as "not after the last
+// accepted one" and the tracker dropped every observation as too old, so beliefs stopped; now both reset once
+// and beliefs stamped after the jump appear.
 #include <gtest/gtest.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <picker_localisation/PickerBelief.h>
@@ -74,7 +74,8 @@ TEST(ClockJump, BeliefsContinueAfterTheClockJumpsBack) {
   EXPECT_GE(after_jump, 5u) << "beliefs stamped after the jump back: " << after_jump;
   EXPECT_GE(belief_stamps.back(), 15.0);
   EXPECT_LE(belief_stamps.back(), 26.0);
-  // The evaluator samples the new time line too (before issue 17's fix its next sample lay 100 s ahead).
+  // The evaluator samples the new time line too (before clock jumps were handled its next sample lay 100 s
+  // ahead).
   EXPECT_GE(errors_after, 5u) << error_stamps.size() << " error samples, " << errors_after << " after the jump";
 }
 

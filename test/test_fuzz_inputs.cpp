@@ -1,8 +1,8 @@
-// Fuzz tests of every parser and front-end a message or a file reaches (issue 17 "No input may kill a node"):
-// seeded random field values and sizes (NaN, +-Inf, 0, huge, negative, random) through the GNSS ingest, the RFID
-// model, UWB ranging, the leg pipeline, LaserScan and PointCloud2 conversion, the Observation message -> TPF
-// path, the map message and the map loader (mutated tmap2 text, random bytes). Each target must neither crash nor
-// throw anything but its documented error, and whatever it outputs must be valid (observations pass
+// Fuzz tests of every parser and front-end a message or a file reaches (no input may kill a node):
+// seeded random field values and sizes (NaN, +-Inf, 0, huge, negative, random) through the GNSS ingest, the
+// RFID model, UWB ranging, the leg pipeline, LaserScan and PointCloud2 conversion, the Observation message ->
+// TPF path, the map message and the map loader (mutated tmap2 text, random bytes). Each target must neither
+// crash nor throw anything but its documented error, and whatever it outputs must be valid (observations pass
 // validateObservation, beliefs sum to 1). Seeded: a failure reproduces; the iteration is in the message.
 #include <gtest/gtest.h>
 #include <pcl/console/print.h>

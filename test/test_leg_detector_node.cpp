@@ -275,7 +275,8 @@ TEST(LegDetectorNode, PointCloudPerson) {
     *z = p.z();
     ++x, ++y, ++z;
   }
-  // Malformed clouds first (issue 17: SIGSEGV on width x point_step beyond the data): dropped, node alive.
+  // Malformed clouds first (they once crashed the node: SIGSEGV on width x point_step beyond the data):
+  // dropped, node alive.
   {
     sensor_msgs::PointCloud2 bad = cloud;
     bad.header.stamp = ros::Time::now();

@@ -1,7 +1,7 @@
 // rostest: the leg_detector node and the offline runner's pipeline (vision::LegPipeline built as
 // eval::runOnce builds it) turn identical scans into identical Observations. Real labelled scans (leg_tracker
 // positive_4) are published on two laser topics in two frames, interleaved as two corner lasers would be, so
-// a runner that shared one tracker between the lasers (the bug of issue 16) produces other observations. The
+// a runner that shared one tracker between the lasers (a bug it once had) produces other observations. The
 // lasers' negative information ("nobody at these nodes") is compared too.
 #include <geometry_msgs/PoseArray.h>
 #include <gtest/gtest.h>

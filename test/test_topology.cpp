@@ -186,6 +186,12 @@ TEST(Queries, NeighboursEdgeLengthHopsAndPaths) {
             (std::vector<NodeIndex>{id("r0_0"), id("H0"), id("H1"), id("r1_0")}));
   EXPECT_DOUBLE_EQ(m.pathLength(id("T1"), id("T1")), 0.0);
   EXPECT_DOUBLE_EQ(m.distance(id("r0_0"), id("r1_0")), 1.5);
+  // Every length from one source at once: the same lengths.
+  const std::vector<double> from = m.pathLengthsFrom(id("r0_0"));
+  ASSERT_EQ(from.size(), m.numNodes());
+  EXPECT_DOUBLE_EQ(from[id("r1_0")], 5.5);
+  EXPECT_DOUBLE_EQ(from[id("r0_0")], 0.0);
+  for (NodeIndex n = 0; n < m.numNodes(); ++n) EXPECT_NEAR(from[n], m.pathLength(id("r0_0"), n), 1e-9);
 }
 
 TEST(Queries, UnreachableNodes) {
@@ -199,6 +205,8 @@ TEST(Queries, UnreachableNodes) {
   EXPECT_EQ(m.numComponents(), 2u);
   EXPECT_EQ(m.hopDistance(0, 2), -1);
   EXPECT_TRUE(std::isinf(m.pathLength(0, 2)));
+  EXPECT_TRUE(std::isinf(m.pathLengthsFrom(0)[2]));
+  EXPECT_TRUE(std::isinf(m.pathLengthsFrom(3)[0]));  // a source out of range reaches nothing
   EXPECT_TRUE(m.shortestPath(0, 2).empty());
   // Duplicate directed edges are kept once; the reverse counts as another directed edge.
   TopologicalMap d = TopologicalMap::build("t", nodes, {{"1", "a", "b", ""}, {"2", "a", "b", ""}, {"3", "b", "a", ""}});

@@ -370,7 +370,7 @@ TEST(LegPipeline, NegativeObservationListsEveryNodeAndLowersOnlyTheSeenEmptyOnes
   EXPECT_FALSE(off.negativeObservation("laser", 100.0, scan, laser, {}, map, "robot_1").has_value());
 }
 
-// Images smaller than the HOG window (64 x 128) or of another type crashed OpenCV 4.6 (issue 17): no boxes now.
+// Images smaller than the HOG window (64 x 128) or of another type crashed OpenCV 4.6 once: no boxes now.
 TEST(HogPersonDetector, TinyAndOddImagesGiveNoBoxesAndNoCrash) {
   picker_localisation::vision::HogPersonDetector hog;
   for (const cv::Size s : {cv::Size(1, 1), cv::Size(10, 10), cv::Size(128, 64), cv::Size(640, 2), cv::Size(63, 127),

@@ -4,8 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
-#include <queue>
 #include <stdexcept>
 
 #include "picker_localisation/core/yaml_keys.h"
@@ -52,7 +50,7 @@ std::string DispatcherOptions::validate() const {
 const std::vector<std::string>& DispatcherOptions::yamlKeys() {
   static const std::vector<std::string> keys = {"robot_speed",      "arrival_distance", "load_time",
                                                 "arrival_min_rssi", "commit_share",     "commit_wait",
-                                                "storage_node"};
+                                                "storage_node",     "arrival_by_lidar"};
   return keys;
 }
 
@@ -64,6 +62,7 @@ DispatcherOptions DispatcherOptions::fromYaml(const YAML::Node& node, std::vecto
   core::readOption(node, c, "load_time", o.load_time);
   core::readOption(node, c, "arrival_min_rssi", o.arrival_min_rssi);
   core::readOption(node, c, "commit_share", o.commit_share);
+  core::readOption(node, c, "arrival_by_lidar", o.arrival_by_lidar);
   core::readOption(node, c, "commit_wait", o.commit_wait);
   core::readOption(node, c, "storage_node", o.storage_node);
   return core::checkOptions(o, node, yamlKeys(), c, unknown);
@@ -173,6 +172,11 @@ bool CallDispatcher::sighting(const std::string& robot_id, const std::string& pi
   return false;
 }
 
+bool CallDispatcher::lidarPerson(const std::string& robot_id, const std::string& picker_id, double stamp,
+                                 double distance) {
+  return options_.arrival_by_lidar && sighting(robot_id, picker_id, stamp, distance);
+}
+
 bool CallDispatcher::rfidRead(const std::string& robot_id, const std::string& picker_id, double stamp,
                               double rssi) {
   return rssi >= options_.arrival_min_rssi && sighting(robot_id, picker_id, stamp, 0.0);
@@ -181,24 +185,7 @@ bool CallDispatcher::rfidRead(const std::string& robot_id, const std::string& pi
 const std::vector<double>& CallDispatcher::distancesFrom(NodeIndex source) const {
   auto it = distances_.find(source);
   if (it != distances_.end()) return it->second;
-  std::vector<double> d(map_->numNodes(), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, NodeIndex>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> open;
-  d[source] = 0.0;
-  open.push({0.0, source});
-  while (!open.empty()) {
-    const auto [dist, n] = open.top();
-    open.pop();
-    if (dist > d[n]) continue;
-    for (NodeIndex m : map_->neighbours(n)) {
-      const double step = map_->edgeLength(n, m).value_or(map_->distance(n, m));
-      if (dist + step < d[m]) {
-        d[m] = dist + step;
-        open.push({d[m], m});
-      }
-    }
-  }
-  return distances_.emplace(source, std::move(d)).first->second;
+  return distances_.emplace(source, map_->pathLengthsFrom(source)).first->second;
 }
 
 double CallDispatcher::expectedDistance(NodeIndex from, const std::string& picker_id) const {

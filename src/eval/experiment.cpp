@@ -238,6 +238,7 @@ sim::SimConfig simConfigFor(const RunConfig& config, const MethodSpec& spec) {
     sc.robot_motion.patrol = sim::PatrolPolicy::kStay;
     sc.calls.enabled = true;
     sc.enable.rfid = true;
+    sc.enable.laser = true;  // every robot has its lasers; the method decides what its belief uses
   }
   sc.enable.uwb = false;
   sc.enable.camera = false;
@@ -287,7 +288,7 @@ class GraphRun {
   };
   void publish(const core::Observation& obs);
   NodeIndex estimate(std::size_t picker) const;
-  void arrived(std::uint64_t call_id, std::size_t robot, double stamp);  // scoring an arrival
+  void arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by);  // scoring an arrival
   // The calls scenario at the end of a step: beliefs and robot nodes to the dispatcher, its goals to the
   // robots, loaded pickers released, each open call scored.
   void dispatchCalls(double now);
@@ -329,7 +330,7 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
   rfid_ = std::make_unique<sensors::RfidObservationModel>(
       core::PickerRegistry(registry_entries), map_,
       rfidOptions(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml")));
-  if (spec_.lidar) {  // the leg_detector node's pipeline, from the same files and keys
+  if (spec_.lidar || config.scenario == Scenario::kCalls) {  // leg_detector's pipeline, same files and keys
     auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(legModelPath(config));
     legs_ = std::make_unique<vision::LegPipeline>(
@@ -434,7 +435,7 @@ void GraphRun::onRfid(const sim::RfidReadingWithTruth& rr) {
     if (dispatcher_ && r.observation->identifying) {
       const dispatch::Call* served = dispatcher_->servedBy(robot_id);
       if (served && dispatcher_->rfidRead(robot_id, r.observation->picker_id, rr.stamp, rr.rssi))
-        arrived(served->id, rr.robot_index, rr.stamp);
+        arrived(served->id, rr.robot_index, rr.stamp, "rfid");
     }
   }
   for (const auto& neg : r.negative) publish(neg);
@@ -459,8 +460,8 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
     if (a.picker >= 0 && dispatcher_) {  // the serving robot's own identified person: arrival when near
       const dispatch::Call* served = dispatcher_->servedBy(s.robot_id);
       const double d = (t.position - simulator_.robotPose(s.robot_index).position()).norm();
-      if (served && dispatcher_->sighting(s.robot_id, a.observation.picker_id, s.stamp, d))
-        arrived(served->id, s.robot_index, s.stamp);
+      if (served && dispatcher_->lidarPerson(s.robot_id, a.observation.picker_id, s.stamp, d))
+        arrived(served->id, s.robot_index, s.stamp, "lidar");
     }
     if (a.picker >= 0) {
       ++result_.identified_detections;
@@ -488,12 +489,14 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
   if (!people.empty()) ukf_.addDetections(s.stamp, people);
 }
 
-void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp) {
+void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by) {
   OpenCall& c = open_calls_.at(call_id);
   c.arrived = true;
   c.record.arrival_s = stamp - c.record.stamp;
-  c.record.false_arrival =
-      (simulator_.robotPose(robot).position() - simulator_.pickerPose(c.picker).position()).norm() > 3.0;
+  c.record.arrival_distance =
+      (simulator_.robotPose(robot).position() - simulator_.pickerPose(c.picker).position()).norm();
+  c.record.false_arrival = c.record.arrival_distance > 3.0;
+  c.record.arrived_by = by;
 }
 
 void GraphRun::onCall(const sim::PickerCall& call) {
@@ -843,10 +846,13 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     std::vector<std::vector<ErrorSample>> samples;
     for (std::size_t k = 0; k < config.runs && config.scenario == Scenario::kCalls; ++k) {
       std::ofstream calls(fs::path(config.out_dir) / method / ("calls_" + std::to_string(k) + ".csv"));
-      calls << "picker_id,stamp,arrival_s,wrong_lane_entries,false_arrival,metres,reported_row\n";
+      calls
+          << "picker_id,stamp,arrival_s,wrong_lane_entries,false_arrival,arrival_distance,arrived_by,metres,"
+             "reported_row\n";
       for (const CallRecord& c : runs[k].calls)
         calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
-              << c.false_arrival << "," << c.metres << "," << c.reported_row << "\n";
+              << c.false_arrival << "," << c.arrival_distance << "," << c.arrived_by << "," << c.metres << ","
+              << c.reported_row << "\n";
     }
     for (std::size_t k = 0; k < config.runs; ++k) {
       writeRunCsv((fs::path(config.out_dir) / method / ("run_" + std::to_string(k) + ".csv")).string(), *map,

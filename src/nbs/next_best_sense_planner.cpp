@@ -27,29 +27,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNegligibleMass = 1e-9;  // belief mass in a read region below this gives no gain
 
-// Single-source shortest path lengths (m) over the undirected motion graph; +inf when unreachable.
-std::vector<double> pathLengthsFrom(const TopologicalMap& map, NodeIndex source) {
-  std::vector<double> dist(map.numNodes(), kInf);
-  if (source >= map.numNodes()) return dist;
-  using Item = std::pair<double, NodeIndex>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  dist[source] = 0.0;
-  queue.push({0.0, source});
-  while (!queue.empty()) {
-    const auto [d, n] = queue.top();
-    queue.pop();
-    if (d > dist[n]) continue;
-    for (NodeIndex m : map.neighbours(n)) {
-      const double length = map.edgeLength(n, m).value_or(map.distance(n, m));
-      if (d + length < dist[m]) {
-        dist[m] = d + length;
-        queue.push({dist[m], m});
-      }
-    }
-  }
-  return dist;
-}
-
 // t_k of LaneCheckModel: the node masses blurred by a 2D Gaussian of covariance `cov` (the bias covariance).
 // Each node's mass is spread over the nodes within 3 sigma of it, in proportion to the Gaussian density and
 // normalised per source node (so no mass is lost). A covariance below 1 cm std leaves the masses as they are.
@@ -373,7 +350,7 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
   result.policy = Policy::kNextBestSense;
   result.criteria = criterionNames();
   const std::size_t n = map_->numNodes();
-  const std::vector<double> dist = pathLengthsFrom(*map_, robot);
+  const std::vector<double> dist = map_->pathLengthsFrom(robot);
   std::vector<NodeIndex> nodes = candidateNodes(robot, claims);
   if (config_.horizon_m > 0.0)
     nodes.erase(
@@ -562,8 +539,8 @@ PlanResult NextBestSensePlanner::planEstimatedNode(NodeIndex robot, double batte
   // reachable node is ranked by its path length to the estimate (the horizon does not apply: the policy goes
   // wherever the estimate is).
   const NodeIndex estimate = target->estimatedNode();
-  const std::vector<double> to_estimate = pathLengthsFrom(*map_, estimate);
-  const std::vector<double> from_robot = pathLengthsFrom(*map_, robot);
+  const std::vector<double> to_estimate = map_->pathLengthsFrom(estimate);
+  const std::vector<double> from_robot = map_->pathLengthsFrom(robot);
   std::vector<NodeIndex> nodes;
   {
     const auto hops = map_->hopDistances(robot);

@@ -460,6 +460,28 @@ std::vector<NodeIndex> TopologicalMap::shortestPath(NodeIndex a, NodeIndex b) co
   return path;
 }
 
+std::vector<double> TopologicalMap::pathLengthsFrom(NodeIndex source) const {
+  std::vector<double> dist(nodes_.size(), std::numeric_limits<double>::infinity());
+  if (source >= nodes_.size()) return dist;
+  using Item = std::pair<double, NodeIndex>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> pq;
+  dist[source] = 0.0;
+  pq.push({0.0, source});
+  while (!pq.empty()) {
+    const auto [d, u] = pq.top();
+    pq.pop();
+    if (d > dist[u]) continue;
+    for (NodeIndex v : neighbours_[u]) {
+      const double nd = d + distance(u, v);
+      if (nd < dist[v]) {
+        dist[v] = nd;
+        pq.push({nd, v});
+      }
+    }
+  }
+  return dist;
+}
+
 double TopologicalMap::pathLength(NodeIndex a, NodeIndex b) const {
   std::vector<NodeIndex> path = shortestPath(a, b);
   if (path.empty()) return std::numeric_limits<double>::infinity();

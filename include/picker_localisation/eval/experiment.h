@@ -93,6 +93,8 @@ struct CallRecord {
   double arrival_s = 0.0;              // s from the call to the arrival (+inf: not arrived by the run's end)
   std::size_t wrong_lane_entries = 0;  // lanes the serving robot drove into that the picker was not in
   bool false_arrival = false;          // arrival declared with the picker more than 3 m from the robot
+  double arrival_distance = 0.0;       // m, robot to picker when the arrival was declared (truth)
+  std::string arrived_by;              // "rfid" or "lidar": the sensing that declared the arrival
   double metres = 0.0;                 // driven by the serving robot from assignment to arrival
   bool reported_row = false;           // the call carried a reported row
 };

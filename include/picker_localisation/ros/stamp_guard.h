@@ -1,7 +1,8 @@
-// Time sanity for nodes that keep time state (issue 17): stamps implausibly far in the future are rejected
-// instead of adopted (one would block every later message), and a backwards jump of the node's clock (a bag
-// replayed with -l, a simulator restart) is detected once so the node can reset its time state. Differences
-// are taken in double seconds: ros::Duration throws ("out of dual 32-bit range") for a stamp decades away.
+// Time sanity for nodes that keep time state (no input may stop a node): stamps implausibly far in the future
+// are rejected instead of adopted (one would block every later message), and a backwards jump of the node's
+// clock (a bag replayed with -l, a simulator restart) is detected once so the node can reset its time state.
+// Differences are taken in double seconds: ros::Duration throws ("out of dual 32-bit range") for a stamp
+// decades away.
 #pragma once
 
 #include <ros/time.h>

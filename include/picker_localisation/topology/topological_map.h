@@ -160,6 +160,9 @@ class TopologicalMap {
   std::shared_ptr<const std::vector<int>> hopDistances(NodeIndex a) const;
   // Shortest path length in metres through the undirected motion graph (Dijkstra); +inf when unreachable.
   double pathLength(NodeIndex a, NodeIndex b) const;
+  // Shortest path lengths in metres from `source` to every node (Dijkstra; +inf unreachable, all +inf for an
+  // index out of range).
+  std::vector<double> pathLengthsFrom(NodeIndex source) const;
   // Shortest path as a node sequence from a to b (both included); empty when unreachable.
   std::vector<NodeIndex> shortestPath(NodeIndex a, NodeIndex b) const;
 
