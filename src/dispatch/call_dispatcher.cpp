@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/yaml_keys.h"
 
 namespace picker_localisation {
@@ -131,15 +132,12 @@ bool CallDispatcher::setBelief(const std::string& picker_id, const std::vector<N
                                const std::vector<double>& masses) {
   if (nodes.empty() || nodes.size() != masses.size()) return false;
   Belief b;
-  double total = 0.0;
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     if (nodes[k] >= map_->numNodes() || !(masses[k] > 0.0) || !std::isfinite(masses[k])) continue;
     b.nodes.push_back(nodes[k]);
     b.masses.push_back(masses[k]);
-    total += masses[k];
   }
-  if (!(total > 0.0)) return false;
-  for (double& m : b.masses) m /= total;
+  if (b.nodes.empty() || !core::normaliseMasses(b.masses)) return false;
   beliefs_[picker_id] = std::move(b);
   return true;
 }
