@@ -1,9 +1,13 @@
 #!/usr/bin/env bash
 # rviz loads rviz/picker_localisation.rviz under Xvfb and renders: the process stays up, the log reports no
-# config/plugin errors, and a screenshot of the screen is not blank. Usage: check_rviz.sh OUT.png [LAUNCH]
+# config/plugin errors, and a screenshot of the screen is not blank. Usage: check_rviz.sh OUT.png [LAUNCH [COLOUR...]]
+# Each COLOUR (name=R,G,B) must cover at least 20 pixels of the screenshot (within 12 % fuzz): a display drawn in
+# that colour rendered.
 set -u
 out="${1:-$(mktemp --suffix=.png)}"
 launch="${2:-$(rospack find picker_localisation)/test/rviz_check.launch}"
+shift 2 2>/dev/null || shift $#
+colours_expected=("$@")
 settle="${RVIZ_SETTLE:-12}"         # wall s before the first screenshot
 deadline="${RVIZ_DEADLINE:-60}"     # wall s for rviz to render at all (a loaded machine), retried every 2 s
 tries=$(( deadline > settle ? (deadline - settle) / 2 + 1 : 1 ))
@@ -48,6 +52,13 @@ colours="$(convert "$out" -format '%k' info:)"
 echo "screenshot $out: grey std $std, $colours colours"
 awk -v s="$std" 'BEGIN{exit !(s > 0.05)}' || { echo "FAIL: screenshot is nearly uniform"; fail=1; }
 [ "$colours" -gt 50 ] || { echo "FAIL: too few colours"; fail=1; }
+for expected in "${colours_expected[@]}"; do
+  name="${expected%%=*}"; rgb="rgb(${expected#*=})"
+  pixels="$(convert "$out" -fuzz 12% -fill black +opaque "$rgb" -fill white -opaque "$rgb" -colorspace Gray \
+    -format '%[fx:round(mean*w*h)]' info:)"
+  echo "$name $rgb: $pixels pixels"
+  [ "${pixels:-0}" -ge 20 ] || { echo "FAIL: nothing drawn in $name $rgb"; fail=1; }
+done
 [ $fail -eq 0 ] || { echo "--- roslaunch log ---"; tail -40 "$log"; }
 rm -f "$log" "$alive"
 exit $fail

@@ -6,7 +6,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <limits>
+
 #include "picker_localisation/dispatch/call_dispatcher.h"
+#include "picker_localisation/dispatch/call_input.h"
 #include "picker_localisation/topology/synthetic_map.h"
 
 using namespace picker_localisation;
@@ -214,4 +217,102 @@ TEST(CallDispatcher, AnIdentifiedLidarPersonNearTheRobotIsArrival) {
   EXPECT_FALSE(d.lidarPerson("robot_1", "picker_1", 6.0, 1.6));  // beyond arrival_distance (1.5 m)
   EXPECT_TRUE(d.lidarPerson("robot_1", "picker_1", 7.0, 1.4));
   EXPECT_EQ(d.find(id)->state, CallState::kArrived);
+}
+
+TEST(CallInput, TheCarAppsJsonIsReadOrRefusedWithTheReason) {
+  std::string error;
+  auto c = dispatch::parseCarMessage(
+      R"({"user": "picker_7", "lat": 53.268, "long": -0.524, "row": 3, "state": "CALLED", "accu": 4.5})",
+      &error);
+  ASSERT_TRUE(c) << error;
+  EXPECT_EQ(c->picker_id, "picker_7");
+  EXPECT_TRUE(c->has_fix);
+  EXPECT_DOUBLE_EQ(c->latitude, 53.268);
+  EXPECT_DOUBLE_EQ(c->longitude, -0.524);
+  EXPECT_EQ(c->row, "3");
+  EXPECT_FALSE(c->cancel);
+  c = dispatch::parseCarMessage(R"({"user": "picker_7", "state": "cancel"})");
+  ASSERT_TRUE(c);
+  EXPECT_TRUE(c->cancel);
+  EXPECT_FALSE(c->has_fix);
+  for (const char* bad : {R"({"user": "picker_7", "lat": )", "[1, 2]", R"({"lat": 53.2, "long": -0.5})",
+                          R"({"user": "", "lat": 53.2, "long": -0.5})", R"({"user": "p", "lat": 53.2})",
+                          R"({"user": "p", "lat": "north", "long": -0.5})", "", "null"}) {
+    error.clear();
+    EXPECT_FALSE(dispatch::parseCarMessage(bad, &error)) << bad;
+    EXPECT_FALSE(error.empty()) << bad;
+  }
+}
+
+TEST(CallInput, AFixOrRowTheMapCannotUseIsLeftOutWithANote) {
+  auto map = polytunnel();
+  core::DatumConfig dc;
+  dc.latitude = 53.268;
+  dc.longitude = -0.524;
+  const core::GeodeticDatum datum(dc);
+  dispatch::CallInput in;
+  in.picker_id = "picker_1";
+  in.has_fix = true;
+  const Eigen::Vector2d on_map = map->position2d(node(*map, "r4_2"));
+  const Eigen::Vector2d ll = datum.toLatLon(on_map);
+  in.latitude = ll.x();
+  in.longitude = ll.y();
+  in.row = "4";
+  auto checked = dispatch::checkCall(in, *map, &datum, 30.0);
+  EXPECT_TRUE(checked.note.empty()) << checked.note;
+  ASSERT_TRUE(checked.fix);
+  EXPECT_LT((*checked.fix - on_map).norm(), 0.01);
+  EXPECT_EQ(checked.row_lane, map->lane(node(*map, "r4_2")));  // "4" names row_4
+  in.row = "row_4";
+  EXPECT_EQ(dispatch::checkCall(in, *map, &datum, 30.0).row_lane, map->lane(node(*map, "r4_2")));
+  // Off the map, NaN, no datum, an unknown row: left out, each with its reason.
+  in.latitude += 0.01;  // about 1.1 km north
+  in.row = "row_99";
+  checked = dispatch::checkCall(in, *map, &datum, 30.0);
+  EXPECT_FALSE(checked.fix);
+  EXPECT_EQ(checked.row_lane, topology::kNoLane);
+  EXPECT_NE(checked.note.find("off the map"), std::string::npos) << checked.note;
+  EXPECT_NE(checked.note.find("row 'row_99' is not a lane"), std::string::npos) << checked.note;
+  in.latitude = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(dispatch::checkCall(in, *map, &datum, 30.0).note.find("not a WGS84 position"), std::string::npos);
+  in.latitude = ll.x();
+  EXPECT_NE(dispatch::checkCall(in, *map, nullptr, 30.0).note.find("no datum"), std::string::npos);
+}
+
+TEST(CallInput, TheReportedRowIsEvidenceNotARestriction) {
+  auto map = polytunnel();
+  const topology::LaneIndex lane = map->lane(node(*map, "r4_2"));
+  const core::Observation obs = dispatch::reportedRowObservation(*map, lane, "picker_1", 12.0, 0.2);
+  EXPECT_TRUE(obs.identifying);
+  EXPECT_EQ(obs.picker_id, "picker_1");
+  EXPECT_EQ(obs.sensor, "reported_row");
+  EXPECT_DOUBLE_EQ(obs.stamp, 12.0);
+  ASSERT_EQ(obs.nodes.size(), map->numNodes());
+  for (std::size_t k = 0; k < obs.nodes.size(); ++k)
+    EXPECT_DOUBLE_EQ(obs.likelihood[k], map->lane(obs.nodes[k]) == lane ? 1.0 : 0.2);
+  EXPECT_TRUE(dispatch::reportedRowObservation(*map, topology::kNoLane, "picker_1", 12.0, 0.2).empty());
+}
+
+TEST(CallDispatcher, AnEditedMapKeepsCallsRobotsAndBeliefsByNodeName) {
+  auto map = polytunnel();
+  CallDispatcher d(map, options(), {"robot_1"});
+  d.setRobotNode("robot_1", node(*map, "H0"));
+  ASSERT_TRUE(d.setBelief("picker_1", {node(*map, "r8_4")}, {1.0}));
+  const auto id = d.call("picker_1", 10.0);
+  ASSERT_EQ(d.update(10.0).size(), 1u);
+  // The same farm shifted by one lane's worth of nodes in the index order: names stay, indices change.
+  topology::PolytunnelSpec spec;
+  spec.lanes = 13;  // one more lane: node indices after lane 0 move
+  auto edited = std::make_shared<const topology::TopologicalMap>(topology::makePolytunnelMap(spec));
+  const topology::MapChange change = topology::compareMaps(*map, *edited);
+  d.adoptMap(edited, change);
+  EXPECT_EQ(d.find(*id)->target, node(*edited, "r8_4"));
+  EXPECT_EQ(d.target("picker_1"), node(*edited, "r8_4"));
+  EXPECT_TRUE(d.update(11.0).empty()) << "the target did not move on the farm: no new goal";
+  // A change that does not fit the current map, or a map without the storage node, changes nothing.
+  EXPECT_THROW(d.adoptMap(map, change), std::invalid_argument);
+  DispatcherOptions o = options();
+  o.storage_node = "H12";
+  CallDispatcher d2(edited, o, {"robot_1"});
+  EXPECT_THROW(d2.adoptMap(map, topology::compareMaps(*edited, *map)), std::invalid_argument);
 }

@@ -11,7 +11,7 @@
 
 #include "picker_localisation/core/geodetic_datum.h"
 #include "picker_localisation/core/picker_registry.h"
-#include "picker_localisation/dispatch/call_dispatcher.h"
+#include "picker_localisation/dispatch/dispatcher_node_options.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
@@ -65,7 +65,8 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_NO_THROW(nbs::PlannerConfig::fromYamlFile(use("nbs.yaml"), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   unknown.clear();
-  EXPECT_NO_THROW(dispatch::DispatcherOptions::fromYaml(YAML::LoadFile(use("dispatcher.yaml")), &unknown));
+  EXPECT_NO_THROW(
+      dispatch::DispatcherNodeOptions::fromYaml(YAML::LoadFile(use("dispatcher.yaml")), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
   // No unknown-key check in these readers yet (issue "One options schema"): they must load and validate.
   EXPECT_NO_THROW(sim::loadSimConfig(use("sim.yaml")));  // throws on an unknown key itself

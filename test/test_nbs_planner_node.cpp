@@ -327,7 +327,8 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
           (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
           (t.rfind("/pickers/", 0) == 0 && t.size() > 10 && t.substr(t.size() - 10) == "/gnss_bias") ||
           t == "/pickers/beliefs" || t == "/pickers/registry" ||
-          (t.size() > 5 && t.substr(t.size() - 5) == "/goal") || t == "/tf" || t == "/tf_static" ||
+          (t.size() > 5 && t.substr(t.size() - 5) == "/goal") ||
+          (t.size() > 10 && t.substr(t.size() - 10) == "/call_goal") || t == "/tf" || t == "/tf_static" ||
           t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }

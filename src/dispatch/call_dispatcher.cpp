@@ -69,6 +69,17 @@ DispatcherOptions DispatcherOptions::fromYaml(const YAML::Node& node, std::vecto
   return core::checkOptions(o, node, yamlKeys(), c, unknown);
 }
 
+std::string defaultStorageNode(const topology::TopologicalMap& map) {
+  const topology::BoundingBox box = map.boundingBox();
+  std::string best_name;
+  double best = std::numeric_limits<double>::infinity();
+  for (NodeIndex n = 0; n < map.numNodes(); ++n) {
+    const double d = (map.position2d(n) - Eigen::Vector2d(box.min_x, box.min_y)).norm();
+    if (map.lane(n) == topology::kNoLane && d < best) best = d, best_name = map.node(n).name;
+  }
+  return best_name;
+}
+
 CallDispatcher::CallDispatcher(std::shared_ptr<const topology::TopologicalMap> map, DispatcherOptions options,
                                std::vector<std::string> robot_ids)
     : map_(std::move(map)), options_(std::move(options)), robot_ids_(std::move(robot_ids)) {
@@ -291,6 +302,41 @@ std::vector<Goal> CallDispatcher::update(double now) {
     }
   }
   return goals;
+}
+
+void CallDispatcher::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,
+                              const topology::MapChange& change) {
+  if (!map || map->numNodes() == 0) throw std::invalid_argument("CallDispatcher: empty map");
+  if (change.old_to_new.size() != map_->numNodes())
+    throw std::invalid_argument("CallDispatcher: the map change does not fit the current map");
+  NodeIndex storage = topology::kInvalidNode;
+  if (!options_.storage_node.empty()) {
+    const auto s = map->index(options_.storage_node);
+    if (!s)
+      throw std::invalid_argument("CallDispatcher: storage_node '" + options_.storage_node +
+                                  "' is not in the new map");
+    storage = *s;
+  }
+  const auto moveNode = [&](NodeIndex n) {
+    return n == topology::kInvalidNode || n >= change.old_to_new.size() ? topology::kInvalidNode
+                                                                        : change.old_to_new[n];
+  };
+  for (Call& c : calls_) c.target = moveNode(c.target);
+  for (auto& [robot, node] : robot_node_) node = moveNode(node);
+  for (auto& [picker, belief] : beliefs_) {
+    // Two old nodes may land on one new node: their masses add up.
+    std::map<NodeIndex, double> moved;
+    for (std::size_t k = 0; k < belief.nodes.size(); ++k) {
+      const NodeIndex n = moveNode(belief.nodes[k]);
+      if (n != topology::kInvalidNode) moved[n] += belief.masses[k];
+    }
+    belief.nodes.clear();
+    belief.masses.clear();
+    for (const auto& [n, m] : moved) belief.nodes.push_back(n), belief.masses.push_back(m);
+  }
+  map_ = std::move(map);
+  storage_ = storage;
+  distances_.clear();
 }
 
 }  // namespace dispatch

@@ -24,6 +24,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include "picker_localisation/dispatch/call_dispatcher.h"
+#include "picker_localisation/dispatch/call_input.h"
+#include "picker_localisation/dispatch/dispatcher_node_options.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 #include "picker_localisation/nbs/tpf_belief_source.h"
 #include "picker_localisation/sensors_ranging/gnss_fleet.h"
@@ -304,6 +306,7 @@ class GraphRun {
   std::unique_ptr<tpf::TrackerFleet> trackers_;  // Tracker::kTpf
   UkfMetricTracker ukf_;                         // Tracker::kUkf
   std::unique_ptr<dispatch::CallDispatcher> dispatcher_;  // Scenario::kCalls
+  dispatch::DispatcherNodeOptions dispatcher_options_;
   std::map<std::uint64_t, OpenCall> open_calls_;
   std::unique_ptr<nbs::NextBestSensePlanner> planner_;
   std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources_;
@@ -358,18 +361,12 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
   if (config.scenario == Scenario::kCalls) {
     if (spec_.tracker == Tracker::kUkf)
       throw std::runtime_error("the calls scenario has no ukf_metric dispatch");
+    // config/dispatcher.yaml as the dispatcher node loads it (its own keys and the dispatcher's).
     const std::string file = resolveConfigFile(config.dispatcher_config, "dispatcher.yaml");
-    dispatch::DispatcherOptions o = file.empty()
-                                        ? dispatch::DispatcherOptions()
-                                        : dispatch::DispatcherOptions::fromYaml(YAML::LoadFile(file));
-    if (o.storage_node.empty()) {  // this map's: the node outside the lanes nearest its lower-left corner
-      const topology::BoundingBox box = map_->boundingBox();
-      double best = 1e300;
-      for (NodeIndex n = 0; n < map_->numNodes(); ++n) {
-        const double d = (map_->position2d(n) - Eigen::Vector2d(box.min_x, box.min_y)).norm();
-        if (map_->lane(n) == topology::kNoLane && d < best) best = d, o.storage_node = map_->node(n).name;
-      }
-    }
+    dispatcher_options_ = file.empty() ? dispatch::DispatcherNodeOptions()
+                                       : dispatch::DispatcherNodeOptions::fromYaml(YAML::LoadFile(file));
+    dispatch::DispatcherOptions o = dispatcher_options_.dispatcher;
+    if (o.storage_node.empty()) o.storage_node = dispatch::defaultStorageNode(*map_);
     std::vector<std::string> robot_ids;
     for (std::size_t r = 0; r < simulator_.numRobots(); ++r) robot_ids.push_back(simulator_.robot(r).id());
     dispatcher_ = std::make_unique<dispatch::CallDispatcher>(map_, o, robot_ids);
@@ -504,6 +501,17 @@ void GraphRun::onCall(const sim::PickerCall& call) {
   std::string error;
   const auto id = dispatcher_->call(call.picker_id, call.stamp, &error);
   if (!id) throw std::runtime_error("call of " + call.picker_id + " refused: " + error);
+  // The reported row, as the dispatcher node sends it: evidence for the picker's filter (a filter that does
+  // not accept the sensor, e.g. Khan's GNSS-only one, ignores it).
+  dispatch::CallInput input;
+  input.picker_id = call.picker_id;
+  input.row = call.reported_row;
+  const dispatch::CheckedCall checked =
+      dispatch::checkCall(input, *map_, nullptr, dispatcher_options_.max_fix_distance);
+  if (checked.row_lane != topology::kNoLane && dispatcher_options_.row_evidence_floor < 1.0 && trackers_ &&
+      spec_.tracker == Tracker::kTpf)
+    publish(dispatch::reportedRowObservation(*map_, checked.row_lane, call.picker_id, call.stamp,
+                                             dispatcher_options_.row_evidence_floor));
   OpenCall c;
   c.picker = call.picker_index;
   c.record.picker_id = call.picker_id;

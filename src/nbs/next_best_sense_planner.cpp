@@ -201,11 +201,11 @@ const std::vector<std::string>& PlannerConfig::yamlKeys() {
 
 const std::vector<std::string>& PlannerConfig::nodeKeys() {
   static const std::vector<std::string> keys = {
-      "robot_id",          "map_frame",    "base_frame",  "battery_level", "claim_timeout",
-      "tf_timeout",        "max_pose_age", "use_what_if", "what_if_seed",  "planning_period",
-      "pickers_file",      "fleet",        "num_robots",  "battery_topic", "goal_pose_topic",
-      "map_file",          "map_topic",    "map_timeout", "belief_topic",  "registry_topic",
-      "registry_publisher"};
+      "robot_id",           "map_frame",      "base_frame",  "battery_level", "claim_timeout",
+      "tf_timeout",         "max_pose_age",   "use_what_if", "what_if_seed",  "planning_period",
+      "pickers_file",       "fleet",          "num_robots",  "battery_topic", "goal_pose_topic",
+      "map_file",           "map_topic",      "map_timeout", "belief_topic",  "registry_topic",
+      "registry_publisher", "call_goal_topic"};
   return keys;
 }
 

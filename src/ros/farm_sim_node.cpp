@@ -3,6 +3,7 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <picker_localisation/BearingDetectionArray.h>
+#include <picker_localisation/PickerCall.h>
 #include <picker_localisation/RfidReading.h>
 #include <picker_localisation/UwbRange.h>
 #include <rosgraph_msgs/Clock.h>
@@ -10,6 +11,7 @@
 #include <sensor_msgs/NavSatFix.h>
 
 #include <cmath>
+#include <limits>
 #include <thread>
 
 #include "picker_localisation/robot/robot_description.h"
@@ -98,6 +100,10 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
   readOptional(y, "enable_rfid", o.enable_rfid);
   readOptional(y, "enable_uwb", o.enable_uwb);
   readOptional(y, "enable_camera", o.enable_camera);
+  readOptional(y, "calls", o.calls);
+  readOptional(y, "tray_time_mean", o.tray_time_mean);
+  core::readOption(y, c, "calls_topic", o.calls_topic);
+  core::readOption(y, c, "call_status_topic", o.call_status_topic);
   core::readOption(y, c, "rate_factor", o.rate_factor);
   core::readOption(y, c, "duration", o.duration);
   core::readOption(y, c, "clock_step", o.clock_step);
@@ -106,14 +112,34 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
   core::readOption(y, c, "ground_truth_rate", o.ground_truth_rate);
   core::readOption(y, c, "publish_sensor_frames", o.publish_sensor_frames);
   core::readOption(y, c, "map_frame", o.map_frame);
-  static const std::vector<std::string> known{"sim_config",  "urdf_template",     "pickers_file",
-                                              "datum_file",  "datum_source",      "seed",
-                                              "robots",      "robot_speed",       "patrol",
-                                              "enable_gnss", "enable_laser",      "enable_rfid",
-                                              "enable_uwb",  "enable_camera",     "rate_factor",
-                                              "duration",    "clock_step",        "start_time",
-                                              "start_delay", "ground_truth_rate", "publish_sensor_frames",
-                                              "map_frame",   "map_file",          "map_topic"};
+  static const std::vector<std::string> known{"sim_config",
+                                              "urdf_template",
+                                              "pickers_file",
+                                              "datum_file",
+                                              "datum_source",
+                                              "seed",
+                                              "robots",
+                                              "robot_speed",
+                                              "patrol",
+                                              "enable_gnss",
+                                              "enable_laser",
+                                              "enable_rfid",
+                                              "enable_uwb",
+                                              "enable_camera",
+                                              "rate_factor",
+                                              "duration",
+                                              "clock_step",
+                                              "start_time",
+                                              "start_delay",
+                                              "ground_truth_rate",
+                                              "publish_sensor_frames",
+                                              "map_frame",
+                                              "map_file",
+                                              "map_topic",
+                                              "calls",
+                                              "tray_time_mean",
+                                              "calls_topic",
+                                              "call_status_topic"};
   return core::checkOptions(o, y, known, c, unknown);
 }
 
@@ -122,6 +148,7 @@ std::string FarmSimOptions::validate() const {
   if (seed && *seed < 0) return bad("seed", *seed, ">= 0");
   if (robots && *robots < 0) return bad("robots", *robots, ">= 0");
   if (robot_speed && !(*robot_speed > 0.0)) return bad("robot_speed", *robot_speed, "> 0");
+  if (tray_time_mean && !(*tray_time_mean > 0.0)) return bad("tray_time_mean", *tray_time_mean, "> 0");
   if (!std::isfinite(rate_factor)) return bad("rate_factor", rate_factor, "finite (<= 0: as fast as possible)");
   if (!(duration >= 0.0)) return bad("duration", duration, ">= 0 (0: forever)");
   if (!(clock_step > 0.0) || !std::isfinite(clock_step)) return bad("clock_step", clock_step, "finite and > 0");
@@ -144,6 +171,8 @@ void FarmSimOptions::applyOverrides(sim::SimConfig& config) const {
   if (enable_rfid) config.enable.rfid = *enable_rfid;
   if (enable_uwb) config.enable.uwb = *enable_uwb;
   if (enable_camera) config.enable.camera = *enable_camera;
+  if (calls) config.calls.enabled = *calls;
+  if (tray_time_mean) config.calls.tray_time_mean = *tray_time_mean;
 }
 
 FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), pnh_(pnh) {
@@ -214,6 +243,13 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
         ns + "/goal", 10, [this, r](const picker_localisation::GoalNode::ConstPtr& m) { onGoal(r, m); });
     robots_.push_back(std::move(io));
   }
+  waiting_since_.assign(sim_->numPickers(), std::numeric_limits<double>::quiet_NaN());
+  if (sim_->config().calls.enabled) {
+    if (!o.calls_topic.empty())
+      calls_pub_ = nh_.advertise<picker_localisation::PickerCall>(o.calls_topic, 20);
+    if (!o.call_status_topic.empty())
+      call_status_sub_ = nh_.subscribe(o.call_status_topic, 10, &FarmSimNode::onCallStatus, this);
+  }
   diagnostics_.setHardwareID("farm_sim");
   diagnostics_.add("simulation", this, &FarmSimNode::diagnose);
   diagnostics_.input("goals");
@@ -264,6 +300,15 @@ void FarmSimNode::publishGroundTruth(const ros::Time& stamp) {
 }
 
 void FarmSimNode::publish(const sim::SimOutputs& out) {
+  for (const auto& c : out.calls) {
+    picker_localisation::PickerCall m;
+    m.header.stamp = toRos(c.stamp);
+    m.picker_id = c.picker_id;
+    m.row = c.reported_row;
+    waiting_since_[c.picker_index] = m.header.stamp.toSec();
+    calls_pub_.publish(m);
+    ++n_calls_;
+  }
   for (const auto& f : out.gnss) {
     if (!fix_pubs_[f.picker_index]) continue;
     sensor_msgs::NavSatFix m;
@@ -338,6 +383,21 @@ void FarmSimNode::publish(const sim::SimOutputs& out) {
   }
 }
 
+void FarmSimNode::onCallStatus(const picker_localisation::CallStatusArray::ConstPtr& msg) {
+  // The trays were loaded (or the call withdrawn): the picker walks on. Only the picker's open call counts
+  // (the status keeps its earlier, closed calls too).
+  for (const auto& c : msg->calls) {
+    if (c.state != "to_storage" && c.state != "done" && c.state != "cancelled") continue;
+    for (std::size_t i = 0; i < sim_->numPickers(); ++i)
+      if (sim_->pickerSpec(i).id == c.picker_id && sim_->pickerWaiting(i) &&
+          std::abs(c.called.toSec() - waiting_since_[i]) < 1e-3) {
+        sim_->releasePicker(i);
+        waiting_since_[i] = std::numeric_limits<double>::quiet_NaN();
+        ++n_released_;
+      }
+  }
+}
+
 void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode::ConstPtr& msg) {
   diagnostics_.tick("goals");
   const std::string& id = sim_->robot(robot).id();
@@ -348,6 +408,9 @@ void FarmSimNode::onGoal(std::size_t robot, const picker_localisation::GoalNode:
     return;
   }
   std::optional<topology::NodeIndex> node;
+  if (msg->node.empty() && !std::isfinite(msg->pose.position.x))
+    return;  // "no goal" (a robot handed back
+             // by the dispatcher): it stays
   if (!msg->node.empty()) {
     node = map_->index(msg->node);
   } else if (std::isfinite(msg->pose.position.x) && std::isfinite(msg->pose.position.y)) {
@@ -376,6 +439,8 @@ void FarmSimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   stat.add("uwb ranges published", n_uwb_);
   stat.add("camera frames published", n_camera_);
   stat.add("goals accepted", goals_accepted_);
+  stat.add("calls", n_calls_);
+  stat.add("pickers released", n_released_);
   stat.add("goals rejected", goals_rejected_);
 }
 

@@ -85,7 +85,8 @@ std_msgs::ColorRGBA laneColour(int lane) {
   std_msgs::ColorRGBA c;
   c.a = 1.0;
   if (lane < 0) {
-    c.r = c.g = c.b = 0.6f;
+    c.r = c.g = c.b = 0.45f;
+    c.a = 0.8f;
     return c;
   }
   // Golden-angle hue walk gives well separated colours for neighbouring lanes.
@@ -100,9 +101,12 @@ std_msgs::ColorRGBA laneColour(int lane) {
     case 4: r = x; b = 1; break;
     default: r = 1; b = x; break;
   }
-  c.r = static_cast<float>(0.25 + 0.75 * r);
-  c.g = static_cast<float>(0.25 + 0.75 * g);
-  c.b = static_cast<float>(0.25 + 0.75 * b);
+  // Pale: the lanes stay told apart, and a belief (saturated cyan -> magenta, drawn larger above the nodes)
+  // stands out against them at a glance.
+  c.r = static_cast<float>(0.55 + 0.3 * r);
+  c.g = static_cast<float>(0.55 + 0.3 * g);
+  c.b = static_cast<float>(0.55 + 0.3 * b);
+  c.a = 0.8f;
   return c;
 }
 

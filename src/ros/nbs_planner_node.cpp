@@ -134,6 +134,11 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   pnh_.param<std::string>("goal_pose_topic", goal_pose_topic, "goal_pose");
   if (!goal_pose_topic.empty()) goal_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>(goal_pose_topic, 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("nbs_candidates", 1, true);
+  // The dispatcher's goal for this robot while it serves a call (dispatcher ~goal_topic; "" none).
+  std::string call_goal_topic;
+  pnh_.param<std::string>("call_goal_topic", call_goal_topic, "call_goal");
+  if (!call_goal_topic.empty())
+    call_goal_sub_ = nh_.subscribe(call_goal_topic, 5, &NbsPlannerNode::callGoalCallback, this);
   candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
   diagnostics_.setHardwareID(robot_id_);
   diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);
@@ -267,7 +272,44 @@ std::optional<topology::NodeIndex> NbsPlannerNode::robotNode() {
   }
 }
 
+void NbsPlannerNode::callGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
+  if (msg->node.empty()) {  // the call ended: the robot is the planner's again
+    if (call_goal_) ROS_INFO("%s: call goal released, planning again", ros::this_node::getName().c_str());
+    call_goal_.reset();
+    planOnce();
+    return;
+  }
+  if (!map_->index(msg->node)) {
+    ++call_goals_rejected_;
+    ROS_WARN_THROTTLE(10.0, "%s: call goal node '%s' is not on the map; ignored",
+                      ros::this_node::getName().c_str(), msg->node.c_str());
+    return;
+  }
+  call_goal_ = *msg;
+  ++call_goals_;
+  forwardCallGoal(ros::Time::now());
+}
+
+void NbsPlannerNode::forwardCallGoal(const ros::Time& stamp) {
+  // The dispatcher's goal is the robot's goal (one goal topic per robot); re-sent each planning period with a
+  // fresh stamp, so the other planners keep seeing the claim on the called picker.
+  picker_localisation::GoalNode g = *call_goal_;
+  g.header.stamp = stamp;
+  g.robot_id = robot_id_;
+  goal_pub_.publish(g);
+  if (goal_pose_pub_) {
+    geometry_msgs::PoseStamped p;
+    p.header = g.header;
+    p.pose = g.pose;
+    goal_pose_pub_.publish(p);
+  }
+}
+
 void NbsPlannerNode::planOnce() {
+  if (call_goal_) {  // serving a call: the dispatcher decides where the robot goes
+    forwardCallGoal(ros::Time::now());
+    return;
+  }
   if (clock_guard_.clockJumpedBack()) {
     // Peer goals stamped in the old time would never age out (claim_timeout counts forward).
     ROS_WARN("nbs_planner: the clock jumped back: peer goals and the last plan forgotten");
@@ -432,6 +474,10 @@ bool NbsPlannerNode::getCandidates(picker_localisation::GetCandidates::Request& 
 }
 
 void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  stat.add("serving a call",
+           call_goal_ ? call_goal_->target_picker + " at " + call_goal_->node : std::string("no"));
+  stat.add("call goals", call_goals_);
+  stat.add("call goals rejected", call_goals_rejected_);
   stat.add("belief topic", beliefs_->topic());
   stat.add("beliefs of pickers not listed", beliefs_of_others_);
   std::size_t with_belief = 0;

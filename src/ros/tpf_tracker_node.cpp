@@ -29,11 +29,12 @@ ros::Time rosTime(double stamp) {
 // Blue (low) -> red (high) for a mass relative to the largest.
 std_msgs::ColorRGBA massColour(double relative) {
   std_msgs::ColorRGBA c;
+  // Saturated cyan (low mass) -> magenta (the most likely node), against the map's pale lane colours.
   const double r = std::clamp(relative, 0.0, 1.0);
-  c.r = static_cast<float>(r);
-  c.g = static_cast<float>(0.2 * (1.0 - r));
-  c.b = static_cast<float>(1.0 - r);
-  c.a = static_cast<float>(0.35 + 0.65 * r);
+  c.r = static_cast<float>(0.1 + 0.9 * r);
+  c.g = static_cast<float>(0.85 * (1.0 - r));
+  c.b = 1.0f;
+  c.a = static_cast<float>(0.5 + 0.5 * r);
   return c;
 }
 
@@ -164,7 +165,7 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& b, const topology::
   nodes.type = visualization_msgs::Marker::SPHERE_LIST;
   nodes.action = visualization_msgs::Marker::ADD;
   nodes.pose.orientation.w = 1.0;
-  nodes.scale.x = nodes.scale.y = nodes.scale.z = 0.6;
+  nodes.scale.x = nodes.scale.y = nodes.scale.z = 1.1;  // larger than the map's nodes (0.5), drawn above them
   double max_mass = 0.0;
   for (double m : b.masses) max_mass = std::max(max_mass, m);
   for (std::size_t k = 0; k < b.nodes.size(); ++k) {
@@ -172,7 +173,7 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& b, const topology::
     const auto& pos = map.node(b.nodes[k]).position;
     p.x = pos.x();
     p.y = pos.y();
-    p.z = pos.z() + 0.1;
+    p.z = pos.z() + 0.6;
     nodes.points.push_back(p);
     nodes.colors.push_back(massColour(max_mass > 0.0 ? b.masses[k] / max_mass : 0.0));
   }

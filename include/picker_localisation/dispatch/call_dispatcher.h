@@ -88,6 +88,10 @@ struct Goal {
   CallState state = CallState::kAssigned;  // the call's state the goal belongs to
 };
 
+// The storage node a farm without one configured gets: the node outside every lane nearest the map's
+// lower-left corner ("" for a map whose nodes are all in lanes). The runner and the dispatcher node alike.
+std::string defaultStorageNode(const topology::TopologicalMap& map);
+
 class CallDispatcher {
  public:
   // Throws std::invalid_argument on invalid options, a null map, an unknown storage node or no robot.
@@ -130,6 +134,12 @@ class CallDispatcher {
   // Where the serving robot of `call` goes now: target(), or a lane end while the belief has not committed.
   topology::NodeIndex goalFor(Call& call, double now) const;
   const DispatcherOptions& options() const { return options_; }
+  const topology::TopologicalMap& map() const { return *map_; }
+  // A new version of the map (edited at run time): targets, robots' nodes and beliefs move to the new map's
+  // node of the same name, else the nearest (change.old_to_new); the storage node is looked up again by name.
+  // Throws std::invalid_argument, changing nothing, for an empty map, a map without the storage node or a
+  // change that does not fit the current map.
+  void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
 
  private:
   struct Belief {

@@ -3,11 +3,12 @@
 // ground truth; /<robot>/goal retargets a robot. Parameters and topics: docs/readme/sim.md, config/sim.yaml.
 #pragma once
 
-#include "picker_localisation/ros/node_diagnostics.h"
+#include <picker_localisation/CallStatusArray.h>
 #include <picker_localisation/GoalNode.h>
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_broadcaster.h>
+#include "picker_localisation/ros/node_diagnostics.h"
 
 #include <map>
 #include <memory>
@@ -35,6 +36,12 @@ struct FarmSimOptions {
   std::optional<double> robot_speed;
   std::optional<std::string> patrol;
   std::optional<bool> enable_gnss, enable_laser, enable_rfid, enable_uwb, enable_camera;
+  // The call scenario (sim.yaml calls:): pickers fill trays, call on calls_topic and wait until the
+  // dispatcher's status (call_status_topic) says their trays were loaded (to_storage, done or cancelled).
+  std::optional<bool> calls;
+  std::optional<double> tray_time_mean;
+  std::string calls_topic = "/dispatcher/calls";         // PickerCall out
+  std::string call_status_topic = "/dispatcher/status";  // CallStatusArray in
   double rate_factor = 10.0;  // simulated s per wall s (<= 0: as fast as possible)
   double duration = 0.0;      // simulated s, then the node exits (0: forever)
   double clock_step = 0.02;   // simulated s per tick
@@ -75,6 +82,7 @@ class FarmSimNode {
   void publishStaticFrames();
   void publishGroundTruth(const ros::Time& stamp);
   void onGoal(std::size_t robot, const picker_localisation::GoalNode::ConstPtr& msg);
+  void onCallStatus(const picker_localisation::CallStatusArray::ConstPtr& msg);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   ros::Time toRos(double sim_t) const { return ros::Time(start_time_ + sim_t); }
 
@@ -89,6 +97,10 @@ class FarmSimNode {
   ros::Publisher clock_pub_;
   std::vector<ros::Publisher> fix_pubs_, truth_pubs_;
   std::vector<RobotIo> robots_;
+  ros::Publisher calls_pub_;
+  ros::Subscriber call_status_sub_;
+  std::vector<double> waiting_since_;  // per picker: the stamp of its open call (NaN: not waiting)
+  std::size_t n_calls_ = 0, n_released_ = 0;
   tf2_ros::TransformBroadcaster tf_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   bool publish_sensor_frames_ = true;

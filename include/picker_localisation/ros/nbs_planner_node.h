@@ -8,7 +8,9 @@
 // nbs_candidates (MarkerArray); service get_candidates returns the ranked candidates. Predictions and
 // hypothetical posteriors come from the trackers' /pickers/<id>/what_if services; the lane check
 // (lane_check/weight > 0, policy nbs) reads each picker's GNSS bias covariance from /pickers/<id>/gnss_bias
-// (gnss_ingest). No ground-truth topic is read. Parameters: config/nbs.yaml.
+// (gnss_ingest). While the robot serves a call, the dispatcher's goal (~call_goal_topic, default call_goal)
+// is the robot's goal and no plan is made; an empty call goal hands the robot back. No ground-truth topic
+// is read. Parameters: config/nbs.yaml.
 #pragma once
 
 #include "picker_localisation/ros/node_diagnostics.h"
@@ -69,6 +71,8 @@ class NbsPlannerNode {
   void biasCallback(const std::string& picker_id, const picker_localisation::GnssBias::ConstPtr& msg);
   void applyPickerList(const std::vector<std::string>& ids);
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
+  void callGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
+  void forwardCallGoal(const ros::Time& stamp);
   void batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg);
   bool getCandidates(picker_localisation::GetCandidates::Request& req,
                      picker_localisation::GetCandidates::Response& res);
@@ -98,7 +102,9 @@ class NbsPlannerNode {
   std::vector<ros::Subscriber> peer_subs_;
   std::map<std::string, PeerGoal> peer_goals_;
   StampGuard clock_guard_;  // jump-back detection only
-  ros::Subscriber battery_sub_;
+  ros::Subscriber battery_sub_, call_goal_sub_;
+  std::optional<picker_localisation::GoalNode> call_goal_;  // the dispatcher's goal while serving a call
+  std::size_t call_goals_ = 0, call_goals_rejected_ = 0;
   ros::Publisher goal_pub_, goal_pose_pub_, marker_pub_;
   ros::ServiceServer candidates_srv_;
   ros::Timer timer_;
