@@ -296,8 +296,12 @@ void NbsPlannerNode::forwardCallGoal(const ros::Time& stamp) {
   picker_localisation::GoalNode g = *call_goal_;
   g.header.stamp = stamp;
   g.robot_id = robot_id_;
+  publishGoal(g);
+}
+
+void NbsPlannerNode::publishGoal(const picker_localisation::GoalNode& g) {
   goal_pub_.publish(g);
-  if (goal_pose_pub_) {
+  if (goal_pose_pub_) {  // the same goal for navigation stacks that take a pose
     geometry_msgs::PoseStamped p;
     p.header = g.header;
     p.pose = g.pose;
@@ -382,13 +386,7 @@ void NbsPlannerNode::publish(const nbs::PlanResult& plan, const ros::Time& stamp
     g.utility = best.utility;
     g.policy = nbs::toString(plan.policy);
     g.target_picker = best.target_picker;
-    goal_pub_.publish(g);
-    if (goal_pose_pub_) {
-      geometry_msgs::PoseStamped p;
-      p.header = g.header;
-      p.pose = g.pose;
-      goal_pose_pub_.publish(p);
-    }
+    publishGoal(g);
   }
   marker_pub_.publish(candidateMarkers(plan, stamp));
   ++markers_published_;

@@ -73,6 +73,7 @@ class NbsPlannerNode {
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void callGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void forwardCallGoal(const ros::Time& stamp);
+  void publishGoal(const picker_localisation::GoalNode& goal);  // on goal and goal_pose
   void batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg);
   bool getCandidates(picker_localisation::GetCandidates::Request& req,
                      picker_localisation::GetCandidates::Response& res);
