@@ -21,8 +21,15 @@ namespace ros_adapter {
 
 namespace {
 
-ros::Time rosTime(double t) {
-  return std::isfinite(t) && t > 0.0 ? ros::Time(t) : ros::Time();
+// The typed call (service or topic) as the dispatcher reads every call.
+dispatch::CallInput callInput(const picker_localisation::PickerCall& msg) {
+  dispatch::CallInput in;
+  in.picker_id = msg.picker_id;
+  in.has_fix = msg.has_fix;
+  in.latitude = msg.latitude;
+  in.longitude = msg.longitude;
+  in.row = msg.row;
+  return in;
 }
 
 std_msgs::ColorRGBA colour(float r, float g, float b, float a = 1.0f) {
@@ -132,7 +139,8 @@ void DispatcherNode::refuse(const std::string& input, const std::string& why) {
 bool DispatcherNode::takeCall(const dispatch::CallInput& input, const ros::Time& stamp, std::string* message,
                               std::uint64_t* call_id) {
   diagnostics_.tick("calls");
-  if (!registry_.find(input.picker_id)) {
+  const core::PickerConfig* picker = registry_.find(input.picker_id);
+  if (!picker) {
     *message = "unknown picker '" + input.picker_id + "' (not in the pickers file or the tracker's list)";
     return false;
   }
@@ -149,8 +157,7 @@ bool DispatcherNode::takeCall(const dispatch::CallInput& input, const ros::Time&
   *call_id = *id;
   call_extras_[*id] = {input.row, checked.note};
   // The call's fix: the picker's GNSS topic, so gnss_ingest places it (a CAR app's only fix of the picker).
-  const core::PickerConfig* picker = registry_.find(input.picker_id);
-  if (checked.fix && options_.forward_fix && picker && !picker->gnss_topic.empty()) {
+  if (checked.fix && options_.forward_fix && !picker->gnss_topic.empty()) {
     auto pub = fix_pubs_.find(picker->gnss_topic);
     if (pub == fix_pubs_.end())
       pub =
@@ -207,13 +214,7 @@ bool DispatcherNode::takeCancel(std::uint64_t call_id, const std::string& picker
 
 bool DispatcherNode::callService(picker_localisation::CallRobot::Request& req,
                                  picker_localisation::CallRobot::Response& res) {
-  dispatch::CallInput in;
-  in.picker_id = req.call.picker_id;
-  in.has_fix = req.call.has_fix;
-  in.latitude = req.call.latitude;
-  in.longitude = req.call.longitude;
-  in.row = req.call.row;
-  res.success = takeCall(in, req.call.header.stamp, &res.message, &res.call_id);
+  res.success = takeCall(callInput(req.call), req.call.header.stamp, &res.message, &res.call_id);
   if (!res.success) refuse("~call", res.message);
   return true;
 }
@@ -233,15 +234,10 @@ bool DispatcherNode::getCallsService(picker_localisation::GetCalls::Request& req
 }
 
 void DispatcherNode::callMessage(const picker_localisation::PickerCall::ConstPtr& msg) {
-  dispatch::CallInput in;
-  in.picker_id = msg->picker_id;
-  in.has_fix = msg->has_fix;
-  in.latitude = msg->latitude;
-  in.longitude = msg->longitude;
-  in.row = msg->row;
   std::string message;
   std::uint64_t id = 0;
-  if (!takeCall(in, msg->header.stamp, &message, &id)) refuse("call on " + calls_sub_.getTopic(), message);
+  if (!takeCall(callInput(*msg), msg->header.stamp, &message, &id))
+    refuse("call on " + calls_sub_.getTopic(), message);
 }
 
 void DispatcherNode::carMessage(const std_msgs::String::ConstPtr& msg) {
@@ -265,11 +261,8 @@ void DispatcherNode::carMessage(const std_msgs::String::ConstPtr& msg) {
 void DispatcherNode::beliefCallback(const picker_localisation::PickerBelief& msg) {
   diagnostics_.tick("beliefs");
   if (msg.nodes.empty()) return;  // waiting for its first observation
-  std::vector<topology::NodeIndex> nodes;
-  std::vector<double> masses;
-  for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k)
-    if (const auto n = map_->index(msg.nodes[k])) nodes.push_back(*n), masses.push_back(msg.masses[k]);
-  if (!dispatcher_->setBelief(msg.picker_id, nodes, masses)) {
+  const BeliefSupport support = beliefSupport(msg, *map_);
+  if (!dispatcher_->setBelief(msg.picker_id, support.nodes, support.masses)) {
     ++beliefs_rejected_;
     ROS_WARN_THROTTLE(10.0, "%s: belief of %s not used (no node of this map with a valid mass)",
                       ros::this_node::getName().c_str(), msg.picker_id.c_str());
@@ -334,7 +327,10 @@ std::optional<Eigen::Vector2d> DispatcherNode::robotPosition(const std::string& 
 void DispatcherNode::update(const ros::Time& now) {
   if (!dispatcher_) return;
   for (const std::string& robot : dispatcher_->robots())
-    if (const auto p = robotPosition(robot)) dispatcher_->setRobotNode(robot, map_->nearestNode(*p));
+    if (const auto p = robotPosition(robot)) {
+      robot_xy_[robot] = *p;
+      dispatcher_->setRobotNode(robot, map_->nearestNode(*p));
+    }
   const std::vector<dispatch::Goal> goals = dispatcher_->update(now.toSec());
   for (const dispatch::Goal& g : goals) sendGoal(g, now);
   // A call that ended frees its robot: its planner positions it again.
@@ -396,10 +392,10 @@ picker_localisation::CallStatus DispatcherNode::statusOf(const dispatch::Call& c
   s.state = dispatch::toString(c.state);
   s.robot_id = c.robot_id;
   if (c.open() && c.target < map_->numNodes()) s.target_node = map_->node(c.target).name;
-  s.called = rosTime(c.stamp);
-  s.assigned = rosTime(c.assigned_at);
-  s.arrived = rosTime(c.arrived_at);
-  s.done = rosTime(c.done_at);
+  s.called = rosStamp(c.stamp);
+  s.assigned = rosStamp(c.assigned_at);
+  s.arrived = rosStamp(c.arrived_at);
+  s.done = rosStamp(c.done_at);
   const auto extra = call_extras_.find(c.id);
   if (extra != call_extras_.end()) s.row = extra->second.first, s.note = extra->second.second;
   if (c.state == dispatch::CallState::kQueued && s.note.empty())
@@ -463,8 +459,8 @@ void DispatcherNode::publishMarkers(const ros::Time& stamp) {
     ring.text.clear();
     array.markers.push_back(ring);
     if (c.robot_id.empty()) continue;
-    const auto robot = robotPosition(c.robot_id);
-    if (!robot) continue;
+    const auto robot = robot_xy_.find(c.robot_id);  // where the last update placed it
+    if (robot == robot_xy_.end()) continue;
     visualization_msgs::Marker line = ring;
     line.ns = "call_routes";
     line.id = id++;
@@ -474,7 +470,7 @@ void DispatcherNode::publishMarkers(const ros::Time& stamp) {
     line.scale.x = 0.25;
     line.color.a = 0.9f;
     geometry_msgs::Point a, b;
-    a.x = robot->x(), a.y = robot->y(), a.z = 0.5;
+    a.x = robot->second.x(), a.y = robot->second.y(), a.z = 0.5;
     b.x = p.x(), b.y = p.y(), b.z = 0.5;
     line.points = {a, b};
     array.markers.push_back(line);

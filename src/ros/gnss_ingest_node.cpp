@@ -321,15 +321,8 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
         msg.picker_id.c_str(), msg.header.stamp.toSec(), stamp_guard_.maxFuture(), msg.nodes.size());
     return;
   }
-  std::vector<topology::NodeIndex> nodes;
-  std::vector<double> masses;
-  for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k) {
-    const auto n = map_->index(msg.nodes[k]);
-    if (!n || !std::isfinite(msg.masses[k]) || msg.masses[k] < 0.0) continue;
-    nodes.push_back(*n);
-    masses.push_back(msg.masses[k]);
-  }
-  if (!fleet_->addBelief(msg.picker_id, msg.header.stamp.toSec(), nodes, std::move(masses))) {
+  BeliefSupport support = beliefSupport(msg, *map_);
+  if (!fleet_->addBelief(msg.picker_id, msg.header.stamp.toSec(), support.nodes, std::move(support.masses))) {
     ++bad_beliefs_;
     ROS_WARN_THROTTLE(10.0, "gnss_ingest: belief of %s dropped: no node of this map with a positive mass",
                       msg.picker_id.c_str());

@@ -6,6 +6,22 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+ros::Time rosStamp(double seconds) {
+  return ros::Time(std::isfinite(seconds) && seconds > 0.0 ? seconds : 0.0);
+}
+
+BeliefSupport beliefSupport(const picker_localisation::PickerBelief& msg,
+                            const topology::TopologicalMap& map) {
+  BeliefSupport support;
+  for (std::size_t k = 0; k < msg.nodes.size() && k < msg.masses.size(); ++k) {
+    const auto n = map.index(msg.nodes[k]);
+    if (!n || !std::isfinite(msg.masses[k]) || msg.masses[k] < 0.0) continue;
+    support.nodes.push_back(*n);
+    support.masses.push_back(msg.masses[k]);
+  }
+  return support;
+}
+
 picker_localisation::Observation toMsg(const core::Observation& obs, const topology::TopologicalMap& map,
                                        const std::string& frame_id) {
   picker_localisation::Observation msg;

@@ -22,10 +22,6 @@ namespace ros_adapter {
 
 namespace {
 
-ros::Time rosTime(double stamp) {
-  return ros::Time(std::max(0.0, std::isfinite(stamp) ? stamp : 0.0));
-}
-
 // Blue (low) -> red (high) for a mass relative to the largest.
 std_msgs::ColorRGBA massColour(double relative) {
   std_msgs::ColorRGBA c;
@@ -91,7 +87,7 @@ tpf::TpfParams tpfParamsWithOverrides(const YAML::Node& base, const std::string&
 picker_localisation::PickerBelief toBeliefMsg(const tpf::Belief& b, const topology::TopologicalMap& map,
                                               const std::string& picker_id, const std::string& frame_id) {
   picker_localisation::PickerBelief m;
-  m.header.stamp = rosTime(b.stamp);
+  m.header.stamp = rosStamp(b.stamp);
   m.header.frame_id = frame_id;
   m.picker_id = picker_id;
   m.nodes.reserve(b.nodes.size());
@@ -124,7 +120,7 @@ geometry_msgs::PoseWithCovarianceStamped toEstimateMsg(const tpf::Belief& b,
                                                        const topology::TopologicalMap& map,
                                                        const std::string& frame_id) {
   geometry_msgs::PoseWithCovarianceStamped m;
-  m.header.stamp = rosTime(b.stamp);
+  m.header.stamp = rosStamp(b.stamp);
   m.header.frame_id = frame_id;
   m.pose.pose.orientation.w = 1.0;
   if (b.map_node == topology::kInvalidNode || b.map_node >= map.numNodes()) return m;
@@ -158,7 +154,7 @@ visualization_msgs::MarkerArray toMarkers(const tpf::Belief& b, const topology::
                                           const std::string& picker_id, const std::string& frame_id) {
   visualization_msgs::MarkerArray arr;
   visualization_msgs::Marker nodes;
-  nodes.header.stamp = rosTime(b.stamp);
+  nodes.header.stamp = rosStamp(b.stamp);
   nodes.header.frame_id = frame_id;
   nodes.ns = picker_id + "/belief";
   nodes.id = 0;

@@ -98,6 +98,7 @@ class DispatcherNode {
   std::map<std::string, ros::Publisher> fix_pubs_;  // by GNSS topic
   ros::ServiceServer call_srv_, cancel_srv_, get_calls_srv_;
   std::map<std::string, RobotIo> robots_;
+  std::map<std::string, Eigen::Vector2d> robot_xy_;  // each robot's position at the last update (map frame)
   std::map<std::uint64_t, std::pair<std::string, std::string>> call_extras_;  // call id -> (row, note)
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

@@ -2,13 +2,28 @@
 #pragma once
 
 #include <picker_localisation/Observation.h>
+#include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/PickerInfo.h>
+#include <ros/time.h>
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
+
+// A core stamp (s) as a ROS time; a non-finite or negative stamp is time zero.
+ros::Time rosStamp(double seconds);
+
+// The support of a tracker's belief on this map: node indices and their masses as sent, leaving out names
+// the map does not have and masses that are not finite or negative (gnss_ingest's association and the
+// dispatcher read beliefs so; the consumer normalises).
+struct BeliefSupport {
+  std::vector<topology::NodeIndex> nodes;
+  std::vector<double> masses;
+};
+BeliefSupport beliefSupport(const picker_localisation::PickerBelief& msg,
+                            const topology::TopologicalMap& map);
 
 picker_localisation::Observation toMsg(const core::Observation& obs, const topology::TopologicalMap& map,
                                        const std::string& frame_id = "map");
