@@ -4,7 +4,9 @@
 # shipped map and on a farm like the one Khan et al. describe (12 lanes of 135 m, 1.5 m apart, generated).
 # Usage: scripts/bench_calls.sh [RUNS] [DURATION_S] [PICKERS] [ROBOTS] [OUT_DIR]
 # Environment: BUILD_DIR (build), METHODS (the scenario's default rows), FARMS ("riseholme long_lanes"),
-# DISPATCHER_CONFIG (config/dispatcher.yaml), SIM_CONFIG (config/sim.yaml: e.g. calls.reported_row_share), JOBS (2).
+# DISPATCHER_CONFIG (config/dispatcher.yaml), SIM_CONFIG (config/sim.yaml: e.g. calls.reported_row_share), JOBS (2),
+# IDLE_ROBOTS (nbs: the planner positions robots serving no call, as nbs_planner does; stay: they wait),
+# SEED (1: runs use seeds SEED .. SEED + RUNS - 1).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 RUNS="${1:-5}"
@@ -21,8 +23,9 @@ python3 scripts/make_polytunnel_map.py "$OUT/long_lanes.tmap2" 12 46 1.5 3.0 --n
 start=$(date +%s)
 for farm in $FARMS; do
   "$BUILD_DIR/devel/lib/picker_localisation/experiment" --map "$OUT/$farm.tmap2" --scenario calls --runs "$RUNS" \
-    --seed 1 --duration "$DURATION" --pickers-count "$PICKERS" --robots "$ROBOTS" --methods "$METHODS" \
-    --dispatcher-config "${DISPATCHER_CONFIG:-config/dispatcher.yaml}" --sim-config "${SIM_CONFIG:-config/sim.yaml}" --jobs "${JOBS:-2}" --out "$OUT/$farm" \
+    --seed "${SEED:-1}" --duration "$DURATION" --pickers-count "$PICKERS" --robots "$ROBOTS" --methods "$METHODS" \
+    --dispatcher-config "${DISPATCHER_CONFIG:-config/dispatcher.yaml}" --sim-config "${SIM_CONFIG:-config/sim.yaml}" \
+    --idle-robots "${IDLE_ROBOTS:-nbs}" --jobs "${JOBS:-2}" --out "$OUT/$farm" \
     > "$OUT/$farm.log" 2>&1 || { echo "experiment failed: $OUT/$farm.log" >&2; exit 1; }
   cat "$OUT/$farm/summary.md"
   echo

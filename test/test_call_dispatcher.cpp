@@ -108,6 +108,14 @@ TEST(CallDispatcher, ArrivalOnlyFromTheServingRobotsOwnSightingThenLoadingStorag
   d.setRobotNode("robot_1", node(*map, "H0"));
   d.update(60.0);
   EXPECT_EQ(d.find(id)->state, CallState::kDone);
+  // The farm's call log line: every time the call passed, the wait from call to arrival, the last target.
+  EXPECT_EQ(
+      dispatch::callLogHeader(),
+      "call_id,picker_id,robot_id,state,called,assigned,arrived,loaded,done,call_to_arrival_s,target_node");
+  EXPECT_EQ(dispatch::callLogLine(*d.find(id), *map),
+            std::to_string(id) + ",picker_1,robot_1,done,10,10,22,52,60,12,H0");
+  const auto open = *d.call("picker_2", 70.0);
+  EXPECT_EQ(dispatch::callLogLine(*d.find(open), *map), std::to_string(open) + ",picker_2,,queued,70,,,,,,");
   EXPECT_DOUBLE_EQ(d.find(id)->done_at, 60.0);
   EXPECT_EQ(d.servedBy("robot_1"), nullptr);
 }

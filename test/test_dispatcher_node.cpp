@@ -21,10 +21,13 @@
 #include <std_msgs/String.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <sstream>
 
 #include "picker_localisation/dispatch/call_dispatcher.h"
 #include "picker_localisation/topology/map_io.h"
@@ -322,6 +325,29 @@ TEST(DispatcherNode, AnswersCallsAndRefusesBadOnes) {
   all.request.include_closed = true;
   ASSERT_TRUE(ros::service::call("/dispatcher/get_calls", all));
   EXPECT_GE(all.response.calls.size(), 7u);
+  // ~calls_log: the header, then every closed call once, with its final state; no open call yet.
+  std::string log_file;
+  ASSERT_TRUE(ros::NodeHandle("~").getParam("calls_log", log_file));
+  std::ifstream log(log_file);
+  std::string line;
+  ASSERT_TRUE(std::getline(log, line)) << log_file;
+  EXPECT_EQ(line, dispatch::callLogHeader());
+  std::map<std::uint64_t, std::string> logged;
+  while (std::getline(log, line)) {
+    std::stringstream cells(line);
+    std::string id, picker, robot, logged_state;
+    std::getline(cells, id, ',');
+    std::getline(cells, picker, ',');
+    std::getline(cells, robot, ',');
+    std::getline(cells, logged_state, ',');
+    EXPECT_TRUE(logged.emplace(std::stoull(id), logged_state).second) << "call " << id << " logged twice";
+  }
+  for (const auto& c : all.response.calls) {
+    const bool closed = c.state == "done" || c.state == "cancelled";
+    ASSERT_EQ(logged.count(c.call_id), closed ? 1u : 0u) << "call " << c.call_id << " " << c.state;
+    if (closed) EXPECT_EQ(logged.at(c.call_id), c.state);
+  }
+  std::remove(log_file.c_str());
   std::lock_guard<std::mutex> lock(g_mutex);
   EXPECT_FALSE(g_shared_robot);
   EXPECT_EQ(state(call_3), "on_the_way");

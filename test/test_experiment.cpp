@@ -300,3 +300,36 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
   EXPECT_LT(std::stod(oracle[5]), 0.2);
   EXPECT_GT(std::stod(raw[5]), std::stod(oracle[5]));  // the raw fix's node is often a lane off
 }
+
+TEST(Experiment, IdleRobotsArePositionedByThePlanner) {
+  // Nobody calls (trays take hours): every robot is idle. With idle_robots "nbs" the planner sends them
+  // where their sensors tell most about the pickers, as nbs_planner does in the ROS graph, so they see and
+  // identify more pickers than robots waiting where they started; with "stay" no goal is given.
+  const fs::path dir = tempDir("idle");
+  const std::string sim = (dir / "sim_idle.yaml").string();
+  {
+    YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
+    y["calls"]["tray_time_mean"] = 1.0e6;
+    std::ofstream(sim) << y;
+  }
+  auto map = std::make_shared<const topology::TopologicalMap>(
+      topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
+  RunConfig rc;
+  rc.scenario = Scenario::kCalls;
+  rc.method = "nbs";
+  rc.seed = 3;
+  rc.duration = 300.0;
+  rc.pickers = 6;
+  rc.robots = 2;
+  rc.sim_config = sim;
+  rc.idle_robots = "stay";
+  const RunResult stay = runOnce(map, rc);
+  rc.idle_robots = "nbs";
+  const RunResult planned = runOnce(map, rc);
+  EXPECT_TRUE(stay.calls.empty());
+  EXPECT_EQ(stay.idle_goals, 0u);
+  EXPECT_GE(planned.idle_goals, 2u);  // at least one goal per robot
+  EXPECT_GT(planned.identified_detections, stay.identified_detections);
+  rc.idle_robots = "wander";
+  EXPECT_THROW(runOnce(map, rc), std::runtime_error);
+}

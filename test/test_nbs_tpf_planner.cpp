@@ -109,3 +109,30 @@ TEST(NbsWithTpf, UninitialisedFilterGivesNoGainAndNoEstimate) {
   cfg.policy = Policy::kEstimatedNode;
   EXPECT_FALSE(NextBestSensePlanner(map, cfg).plan(*map->index("H0"), 1.0, {&s}).ok());
 }
+
+TEST(NbsWithTpf, BeliefSourceAnswersAsTheFilterAtEveryHorizonAndAfterUpdates) {
+  // The source predicts once per horizon and answers every hypothesis at that horizon from that prediction;
+  // its answers must be the filter's own what-if answers (same seed), and follow the live filter when it
+  // changes.
+  auto map = wideTunnels(2.0);
+  tpf::TopologicalParticleFilter f(map, tpf::TpfParams(), 5);
+  const Eigen::Vector2d mid = map->position2d(*map->index("r2_5"));
+  ASSERT_TRUE(f.update(gnss(*map, "p", 1.0, mid, 0.5, 4.0)).ok());
+  TpfBeliefSource s("p", f, 11);
+  core::Observation read;
+  read.sensor = "rfid";
+  read.picker_id = "p";
+  read.identifying = true;
+  read.nodes = {*map->index("r2_5"), *map->index("r2_6")};
+  read.likelihood = {1.0, 1.0};
+  const auto dense = [&](const tpf::Belief& b) { return denseMasses(b, map->numNodes()); };
+  for (int round = 0; round < 2; ++round) {
+    for (double h : {0.0, 4.0, 10.0, 4.0}) {
+      EXPECT_EQ(s.predicted(h), dense(f.predictAhead(h, 11))) << "horizon " << h;
+      EXPECT_EQ(s.posterior(h, read), dense(f.posteriorUnder(read, h, 11))) << "horizon " << h;
+    }
+    const NodeMasses before = s.posterior(4.0, read);
+    ASSERT_TRUE(f.update(gnss(*map, "p", 5.0, map->position2d(*map->index("r2_8")), 0.5, 0.5)).ok());
+    EXPECT_NE(s.posterior(4.0, read), before);  // the live filter moved: no stale answer
+  }
+}

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <tuple>
 
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
@@ -1206,6 +1207,50 @@ TEST(TpfGnssBias, LaneSwapsPauseWhileARobotSeesThePicker) {
   }
   EXPECT_GT(laneMass(*map, f.belief(), here), 0.999);
   EXPECT_LT(laneMass(*map, f.belief(), there), 1e-3);
+}
+
+TEST(TpfGnssBias, AReportedRowMovesTheBeliefIntoItWeighedAgainstTheFixes) {
+  // A minute of phone fixes on lane 5 holds every particle there. The picker reports lane 6 (likelihood 1
+  // there, 0.2 elsewhere). Weighting alone cannot move the belief (no particle in lane 6): it stays in
+  // lane 5. With the lane-evidence moves (swap proposals accepted by the row's likelihood ratio and the
+  // device prior), most of the mass goes to lane 6, some stays in lane 5 (the fixes' evidence), and lane 7,
+  // which neither the row nor the fixes favour, gets little. With a tight prior (a robot measured the bias)
+  // the fixes rule out a 1.5 m shift and the row cannot move the belief.
+  auto map = polytunnel();
+  const NodeIndex here = *map->index("r5_5"), row = *map->index("r6_5"), beyond = *map->index("r7_5");
+  auto afterReport = [&](int sweeps, double prior_variance) {
+    TpfParams p = staticParams(1000);
+    p.gnss_bias_state = true;
+    p.lane_swap_rate = 0.0;  // the moves of the reported row only
+    p.jsd_monitor = false;
+    p.lane_evidence_sweeps = sweeps;
+    TopologicalParticleFilter f(map, p, 23);
+    EXPECT_TRUE(f.update(obsAt(0.0, {here}, {1.0}, true, "uwb")).ok());
+    for (int k = 1; k <= 60; ++k)
+      EXPECT_TRUE(f.update(biasedFix(*map, k, map->position2d(here), 9.0, {0.0, 0.0}, prior_variance,
+                                     2.0 * 6.25 / 300.0))
+                      .ok());
+    core::Observation reported = obsAt(61.0, {}, {}, true, "reported_row");
+    for (NodeIndex n = 0; n < map->numNodes(); ++n) {
+      reported.nodes.push_back(n);
+      reported.likelihood.push_back(map->lane(n) == map->lane(row) ? 1.0 : 0.2);
+    }
+    EXPECT_TRUE(f.update(reported).ok());
+    return std::make_tuple(laneMass(*map, f.belief(), here), laneMass(*map, f.belief(), row),
+                           laneMass(*map, f.belief(), beyond));
+  };
+  const auto [off_here, off_row, off_beyond] = afterReport(0, 10.25);
+  (void)off_beyond;
+  EXPECT_GT(off_here, 0.999);
+  EXPECT_LT(off_row, 1e-3);
+  const auto [on_here, on_row, on_beyond] = afterReport(4, 10.25);
+  EXPECT_GT(on_row, 0.4);  // measured 0.51 (lane 5 0.19, lane 7 0.04, lane 4 the rest)
+  EXPECT_GT(on_row, 2.0 * on_here);
+  EXPECT_GT(on_here, 0.05);
+  EXPECT_LT(on_beyond, 0.1);
+  const auto [tight_here, tight_row, tight_beyond] = afterReport(4, 0.05);
+  EXPECT_GT(tight_here, 0.95);
+  EXPECT_LT(tight_row + tight_beyond, 0.05);
 }
 
 TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {

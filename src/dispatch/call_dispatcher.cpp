@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "picker_localisation/core/observation.h"
@@ -67,6 +68,28 @@ DispatcherOptions DispatcherOptions::fromYaml(const YAML::Node& node, std::vecto
   core::readOption(node, c, "commit_wait", o.commit_wait);
   core::readOption(node, c, "storage_node", o.storage_node);
   return core::checkOptions(o, node, yamlKeys(), c, unknown);
+}
+
+std::string callLogHeader() {
+  return "call_id,picker_id,robot_id,state,called,assigned,arrived,loaded,done,call_to_arrival_s,target_node";
+}
+
+std::string callLogLine(const Call& c, const topology::TopologicalMap& map) {
+  std::ostringstream out;
+  out.precision(12);
+  const auto time = [&out](double t) {
+    out << ',';
+    if (std::isfinite(t)) out << t;
+  };
+  out << c.id << ',' << c.picker_id << ',' << c.robot_id << ',' << toString(c.state);
+  time(c.stamp);
+  time(c.assigned_at);
+  time(c.arrived_at);
+  time(c.loaded_at);
+  time(c.done_at);
+  time(c.arrived_at - c.stamp);
+  out << ',' << (c.target < map.numNodes() ? map.node(c.target).name : std::string());
+  return out.str();
 }
 
 std::string defaultStorageNode(const topology::TopologicalMap& map) {

@@ -56,7 +56,7 @@ const std::vector<std::string>& DispatcherNodeOptions::yamlKeys() {
       "pickers_file", "robots", "num_robots", "map_frame", "base_frame", "update_period", "max_pose_age",
       "goal_topic", "goal_pose_topic", "goal_node_topic", "calls_topic", "car_topic", "rfid_topic",
       "observations_topic", "arrival_sensors", "max_fix_distance", "forward_fix", "row_evidence_floor",
-      "closed_calls_kept", "datum_file", "datum_source",
+      "closed_calls_kept", "calls_log", "datum_file", "datum_source",
       // read by the shared helpers (map_source, fleet_topics), documented with them
       "map_file", "map_topic", "map_timeout", "belief_topic", "registry_topic", "registry_publisher"};
   return keys;
@@ -85,6 +85,7 @@ DispatcherNodeOptions DispatcherNodeOptions::fromYaml(const YAML::Node& node,
   core::readOption(node, c, "forward_fix", o.forward_fix);
   core::readOption(node, c, "row_evidence_floor", o.row_evidence_floor);
   core::readOption(node, c, "closed_calls_kept", o.closed_calls_kept);
+  core::readOption(node, c, "calls_log", o.calls_log);
   core::readOption(node, c, "datum_file", o.datum_file);
   core::readOption(node, c, "datum_source", o.datum_source);
   // The dispatcher's own keys (config/dispatcher.yaml) sit in the same namespace.

@@ -294,6 +294,15 @@ class GraphRun {
   // The calls scenario at the end of a step: beliefs and robot nodes to the dispatcher, its goals to the
   // robots, loaded pickers released, each open call scored.
   void dispatchCalls(double now);
+  // The calls scenario's robots serving no call, positioned by the planner as nbs_planner positions them:
+  // each plans every planning_period (and at once when its call ended) with the other robots' goals as
+  // claims.
+  void positionIdleRobots(double now);
+  // The planner's views of the pickers, with the bias covariance gnss_ingest publishes at `now`.
+  std::vector<nbs::BeliefSource*> views(double now);
+  // The planner of config/nbs.yaml (planning_period, battery_level, what_if_seed as the node reads them) with
+  // `policy`, and a what-if view of every picker's filter.
+  void makePlanner(nbs::Policy policy);
 
   std::shared_ptr<const topology::TopologicalMap> map_;
   RunConfig config_;
@@ -311,6 +320,12 @@ class GraphRun {
   std::unique_ptr<nbs::NextBestSensePlanner> planner_;
   std::vector<std::unique_ptr<nbs::TpfBeliefSource>> sources_;
   double replan_period_ = 0.0, battery_level_ = 1.0, last_plan_ = -1e300;
+  struct IdleRobot {
+    double last_plan = -1e300;
+    bool serving = false;  // served a call at the last step
+    nbs::Claim goal;       // the planner's last goal (node kInvalidNode: none)
+  };
+  std::vector<IdleRobot> idle_;  // calls scenario with idle_robots "nbs", per robot
   RunResult result_;
 };
 
@@ -339,10 +354,13 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
     legs_ = std::make_unique<vision::LegPipeline>(
         classifier, vision::LegPipelineOptions::fromYamlFiles(visionConfigFiles(config.vision_config)));
   }
-  if (spec_.tracker == Tracker::kTpf) {
+  // The calls scenario's farm runs its trackers whatever the dispatcher is told (the oracle's true node, the
+  // raw fix's): they give gnss_ingest's association its beliefs and the planner of idle robots its views.
+  if (spec_.tracker == Tracker::kTpf || config.scenario == Scenario::kCalls) {
     const std::string tpf_file = resolveConfigFile(config.tpf_config, "tpf.yaml");
     const tpf::TpfParams base = tpf_file.empty() ? tpf::TpfParams() : tpf::TpfParams::fromYamlFile(tpf_file);
-    const tpf::TpfParams params = tpf::TpfParams::presetForMethod(spec_.tpf_preset, base);
+    const tpf::TpfParams params =
+        tpf::TpfParams::presetForMethod(spec_.tracker == Tracker::kTpf ? spec_.tpf_preset : "tpf", base);
     trackers_ = std::make_unique<tpf::TrackerFleet>(map_, [this](tpf::TrackerFleet::Track& t) {
       const tpf::Belief& b = t.filter->belief();
       if (b.initialised) gnss_->addBelief(t.id, b.stamp, b.nodes, b.masses);
@@ -370,25 +388,36 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
     std::vector<std::string> robot_ids;
     for (std::size_t r = 0; r < simulator_.numRobots(); ++r) robot_ids.push_back(simulator_.robot(r).id());
     dispatcher_ = std::make_unique<dispatch::CallDispatcher>(map_, o, robot_ids);
-  } else if (spec_.policy != RobotPolicy::kPatrol) {
-    // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
-    // what_if_seed); the method sets the policy.
-    const std::string nbs_file = resolveConfigFile(config.nbs_config, "nbs.yaml");
-    nbs::PlannerConfig pc =
-        nbs_file.empty() ? nbs::PlannerConfig() : nbs::PlannerConfig::fromYamlFile(nbs_file);
-    std::uint64_t what_if_seed = 1;
-    if (!nbs_file.empty()) {
-      const YAML::Node y = YAML::LoadFile(nbs_file);
-      core::readOption(y, nbs_file, "planning_period", replan_period_);
-      core::readOption(y, nbs_file, "battery_level", battery_level_);
-      core::readOption(y, nbs_file, "what_if_seed", what_if_seed);
+    if (config.idle_robots == "nbs") {
+      makePlanner(nbs::Policy::kNextBestSense);
+      idle_.resize(simulator_.numRobots());
+    } else if (config.idle_robots != "stay") {
+      throw std::runtime_error("idle_robots '" + config.idle_robots + "': expected nbs or stay");
     }
-    pc.policy = spec_.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense : nbs::Policy::kEstimatedNode;
-    planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, pc);
-    for (const auto& s : scoring_)
-      sources_.push_back(std::make_unique<nbs::TpfBeliefSource>(s.id, *trackers_->find(s.id)->filter,
-                                                                what_if_seed ? what_if_seed : 1));
+  } else if (spec_.policy != RobotPolicy::kPatrol) {
+    makePlanner(spec_.policy == RobotPolicy::kNbs ? nbs::Policy::kNextBestSense
+                                                  : nbs::Policy::kEstimatedNode);
   }
+}
+
+void GraphRun::makePlanner(nbs::Policy policy) {
+  // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
+  // what_if_seed); the method (or the calls scenario) sets the policy.
+  const std::string nbs_file = resolveConfigFile(config_.nbs_config, "nbs.yaml");
+  nbs::PlannerConfig pc =
+      nbs_file.empty() ? nbs::PlannerConfig() : nbs::PlannerConfig::fromYamlFile(nbs_file);
+  std::uint64_t what_if_seed = 1;
+  if (!nbs_file.empty()) {
+    const YAML::Node y = YAML::LoadFile(nbs_file);
+    core::readOption(y, nbs_file, "planning_period", replan_period_);
+    core::readOption(y, nbs_file, "battery_level", battery_level_);
+    core::readOption(y, nbs_file, "what_if_seed", what_if_seed);
+  }
+  pc.policy = policy;
+  planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, pc);
+  for (const auto& s : scoring_)
+    sources_.push_back(std::make_unique<nbs::TpfBeliefSource>(s.id, *trackers_->find(s.id)->filter,
+                                                              what_if_seed ? what_if_seed : 1));
 }
 
 void GraphRun::publish(const core::Observation& obs) {
@@ -543,6 +572,8 @@ void GraphRun::dispatchCalls(double now) {
       c.robot = r;
       c.robot_at = simulator_.robotPose(r).position();
       c.robot_node = simulator_.robot(r).currentNode();
+      // A robot already in a lane (an idle robot the planner sent there) leaving it has not entered it.
+      c.inside = map_->lane(c.robot_node);
     }
   }
   for (auto it = open_calls_.begin(); it != open_calls_.end();) {
@@ -584,17 +615,67 @@ void GraphRun::finish() {
 
 void GraphRun::endOfStep(double now) {
   if (trackers_) trackers_->predictDue(now);
-  if (dispatcher_) dispatchCalls(now);
+  if (dispatcher_) {
+    dispatchCalls(now);
+    if (planner_) positionIdleRobots(now);
+    return;
+  }
   if (!planner_ || !(simulator_.robot(0).atGoal() || now - last_plan_ >= replan_period_)) return;
-  std::vector<nbs::BeliefSource*> views;
+  const nbs::PlanResult plan = planner_->plan(simulator_.robot(0).currentNode(), battery_level_, views(now));
+  if (plan.ok()) simulator_.setRobotGoal(0, plan.ranked.front().node);
+  last_plan_ = now;
+}
+
+std::vector<nbs::BeliefSource*> GraphRun::views(double now) {
+  std::vector<nbs::BeliefSource*> out;
   for (std::size_t i = 0; i < sources_.size(); ++i) {
     // The bias covariance gnss_ingest publishes (GnssBias.covariance), as the nbs_planner node reads it.
     sources_[i]->setBiasCovariance(gnss_->find(scoring_[i].id)->ingest.bias().appliedCovariance(now));
-    views.push_back(sources_[i].get());
+    out.push_back(sources_[i].get());
   }
-  const nbs::PlanResult plan = planner_->plan(simulator_.robot(0).currentNode(), battery_level_, views);
-  if (plan.ok()) simulator_.setRobotGoal(0, plan.ranked.front().node);
-  last_plan_ = now;
+  return out;
+}
+
+void GraphRun::positionIdleRobots(double now) {
+  std::vector<std::size_t> due;
+  for (std::size_t r = 0; r < simulator_.numRobots(); ++r) {
+    IdleRobot& idle = idle_[r];
+    const bool serving = dispatcher_->servedBy(simulator_.robot(r).id()) != nullptr;
+    const bool released = idle.serving && !serving;  // nbs_planner plans at once when the call goal is freed
+    idle.serving = serving;
+    if (serving) idle.goal = {};
+    if (!serving && (released || now - idle.last_plan >= replan_period_)) due.push_back(r);
+  }
+  if (due.empty()) return;
+  // Every robot's goal as the planners see it on the goal topics: a served call's target (claiming its
+  // picker), else the planner's last goal.
+  std::vector<nbs::Claim> goals;
+  for (std::size_t r = 0; r < simulator_.numRobots(); ++r) {
+    const std::string& id = simulator_.robot(r).id();
+    if (const dispatch::Call* c = dispatcher_->servedBy(id)) {
+      if (c->target != topology::kInvalidNode) goals.push_back({id, c->target, c->picker_id});
+    } else if (idle_[r].goal.node != topology::kInvalidNode) {
+      goals.push_back(idle_[r].goal);
+    }
+  }
+  const std::vector<nbs::BeliefSource*> pickers = views(now);
+  for (std::size_t r : due) {
+    const std::string& id = simulator_.robot(r).id();
+    const nbs::PlanResult plan =
+        planner_->plan(simulator_.robot(r).currentNode(), battery_level_, pickers, nbs::claimsFor(id, goals));
+    idle_[r].last_plan = now;
+    if (!plan.ok()) continue;
+    const nbs::Claim goal{id, plan.ranked.front().node, plan.ranked.front().target_picker};
+    if (goal.node != idle_[r].goal.node) {
+      simulator_.setRobotGoal(r, goal.node);
+      ++result_.idle_goals;
+    }
+    idle_[r].goal = goal;
+    goals.erase(
+        std::remove_if(goals.begin(), goals.end(), [&](const nbs::Claim& g) { return g.robot_id == id; }),
+        goals.end());
+    goals.push_back(goal);
+  }
 }
 
 NodeIndex GraphRun::estimate(std::size_t i) const {

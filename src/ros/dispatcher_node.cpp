@@ -110,6 +110,15 @@ DispatcherNode::DispatcherNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
         nh_.subscribe(options_.observations_topic, 200, &DispatcherNode::observationCallback, this);
     observation_pub_ = nh_.advertise<picker_localisation::Observation>(options_.observations_topic, 10);
   }
+  if (!options_.calls_log.empty()) {
+    const bool fresh = !std::ifstream(options_.calls_log).good();
+    calls_log_.open(options_.calls_log, std::ios::app);
+    if (!calls_log_)
+      ROS_ERROR("%s: cannot write ~calls_log '%s'; calls are not logged", name.c_str(),
+                options_.calls_log.c_str());
+    else if (fresh)
+      calls_log_ << dispatch::callLogHeader() << "\n" << std::flush;
+  }
   status_pub_ = pnh_.advertise<picker_localisation::CallStatusArray>("status", 1, true);
   markers_pub_ = pnh_.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
   call_srv_ = pnh_.advertiseService("call", &DispatcherNode::callService, this);
@@ -404,7 +413,23 @@ picker_localisation::CallStatus DispatcherNode::statusOf(const dispatch::Call& c
   return s;
 }
 
+DispatcherNode::~DispatcherNode() {
+  if (!calls_log_ || !dispatcher_) return;
+  logClosedCalls();
+  for (const dispatch::Call& c : dispatcher_->calls())
+    if (c.open()) calls_log_ << dispatch::callLogLine(c, *map_) << "\n";
+  calls_log_.flush();
+}
+
+void DispatcherNode::logClosedCalls() {
+  if (!calls_log_.is_open() || !calls_log_) return;
+  for (const dispatch::Call& c : dispatcher_->calls())
+    if (!c.open() && logged_calls_.insert(c.id).second) calls_log_ << dispatch::callLogLine(c, *map_) << "\n";
+  calls_log_.flush();
+}
+
 void DispatcherNode::publishStatus(const ros::Time& stamp) {
+  logClosedCalls();
   picker_localisation::CallStatusArray msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = options_.map_frame;

@@ -22,7 +22,8 @@ void usage(std::ostream& o) {
        "                  [--leg-model FILE] [--tpf-config FILE] [--sim-config FILE] [--datum FILE]\n"
        "                  [--pickers FILE] [--gnss-config FILE] [--rfid-config FILE] [--nbs-config FILE]\n"
        "                  [--vision-config FILE[,FILE...]] [--tracker-seed N]\n"
-       "                  [--pickers-count N] [--robots K] [--dispatcher-config FILE]   (scenario calls)\n"
+       "                  [--pickers-count N] [--robots K] [--dispatcher-config FILE]\n"
+       "                  [--idle-robots nbs|stay]   (scenario calls)\n"
        "config files default to the package's config/ (as the ROS graph uses them); 'none' = built-in "
        "defaults\n"
        "methods:";
@@ -98,6 +99,8 @@ int main(int argc, char** argv) {
         cfg.run.robots = std::stoul(v);
       else if (a == "--dispatcher-config")
         cfg.run.dispatcher_config = v;
+      else if (a == "--idle-robots")
+        cfg.run.idle_robots = v;
       else
         throw std::invalid_argument("unknown option " + a);
     }
@@ -107,6 +110,8 @@ int main(int argc, char** argv) {
     for (const auto& m : cfg.methods)
       if (!isKnownMethod(m)) throw std::invalid_argument("unknown method '" + m + "'");
     if (!(cfg.run.sample_period > 0.0)) throw std::invalid_argument("--sample-period must be > 0");
+    if (cfg.run.idle_robots != "nbs" && cfg.run.idle_robots != "stay")
+      throw std::invalid_argument("--idle-robots must be nbs or stay");
   } catch (const std::exception& e) {
     std::cerr << "experiment: " << e.what() << "\n";
     usage(std::cerr);

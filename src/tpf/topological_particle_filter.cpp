@@ -312,7 +312,9 @@ void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::Topologic
       *map, params_.directed_motion,
       params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
       params_.lane_change_max_hops,
-      params_.gnss_bias_state && params_.lane_swap_rate > 0.0 ? params_.lane_swap_max_distance : 0.0);
+      (params_.gnss_bias_state && params_.lane_swap_rate > 0.0) || params_.lane_evidence_sweeps > 0
+          ? params_.lane_swap_max_distance
+          : 0.0);
   std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
   std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0), node_b(map->numNodes(), 0.0);
   std::vector<double> lanes(map->numLanes(), 0.0);
@@ -356,6 +358,9 @@ void TopologicalParticleFilter::reset() {
   bias_stamp_ = 0.0;
   bias_step_ = 0.0;
   other_sensor_stamp_ = -std::numeric_limits<double>::infinity();
+  bias_prior_mean_.setZero();
+  bias_prior_variance_ = 0.0;
+  bias_drift_rate_ = 0.0;
   unconnected_p_ = params_.unconnected_jump_probability;
   belief_.unconnected_jump_probability = unconnected_p_;
 }
@@ -872,7 +877,12 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
 
   resample(total);  // Eq. 11
   if (bias_state) swapLanes(obs);
-  addNoise();       // Eq. 12, leaves the particle counts per node in node_scratch_b_ / touched_
+  const bool moved = params_.isLaneEvidence(obs.sensor) && moveTowardsLaneEvidence();
+  addNoise();   // Eq. 12, leaves the particle counts per node in node_scratch_b_ / touched_
+  if (moved) {  // the belief is the moved particles' (the weights above were those before the moves)
+    recordBelief(true);
+    return overlap;
+  }
   // Entropy of the resampled particles (Alg. 1 l. 12).
   const double inv_n = 1.0 / static_cast<double>(particles_.size());
   double h = 0.0;
@@ -913,6 +923,9 @@ void TopologicalParticleFilter::weighWithBiasState(const core::Observation& obs)
                            : 1.0;
   const double r = bias_fix_variance_;
   const double prior_x = obs.bias_removed->x(), prior_y = obs.bias_removed->y();
+  bias_prior_mean_ = *obs.bias_removed;
+  bias_prior_variance_ = prior_variance;
+  bias_drift_rate_ = obs.bias_drift_rate;
   const float forget = static_cast<float>(std::exp(-dt / params_.lane_swap_memory)),
               step = static_cast<float>(dt);
   double best = -std::numeric_limits<double>::infinity();
@@ -972,18 +985,60 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
     const NodeIndex to = graph_->across[2 * p.node + (rng_() & 1u)];
     if (to == topology::kInvalidNode) continue;
     const Eigen::Vector2d shift = map_->position2d(p.node) - map_->position2d(to);
-    const Eigen::Vector2d b(p.bias_x, p.bias_y), moved = b + shift;
-    const Eigen::Vector2d integral(p.bias_integral_x, p.bias_integral_y);
-    const double log_ratio = ((b - m).squaredNorm() - (moved - m).squaredNorm()) * inv_two_p -
-                             (2.0 * shift.dot(integral) + shift.squaredNorm() * p.bias_time) * inv_four_p_tau;
+    const double log_ratio = swapLogPriorRatio(p, shift, m, inv_two_p, inv_four_p_tau);
     if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
-    p.node = to;
-    p.bias_x = static_cast<float>(moved.x());
-    p.bias_y = static_cast<float>(moved.y());
+    applySwap(p, to, shift);
+  }
+}
+
+double TopologicalParticleFilter::swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift,
+                                                    const Eigen::Vector2d& prior_mean, double inv_two_p,
+                                                    double inv_four_p_tau) const {
+  const Eigen::Vector2d b(p.bias_x, p.bias_y), moved = b + shift;
+  const Eigen::Vector2d integral(p.bias_integral_x, p.bias_integral_y);
+  return ((b - prior_mean).squaredNorm() - (moved - prior_mean).squaredNorm()) * inv_two_p -
+         (2.0 * shift.dot(integral) + shift.squaredNorm() * p.bias_time) * inv_four_p_tau;
+}
+
+void TopologicalParticleFilter::applySwap(Particle& p, NodeIndex to, const Eigen::Vector2d& shift) {
+  p.node = to;
+  if (p.bias_variance >= 0.0f) {
+    p.bias_x = static_cast<float>(p.bias_x + shift.x());
+    p.bias_y = static_cast<float>(p.bias_y + shift.y());
     p.bias_integral_x += static_cast<float>(shift.x() * p.bias_time);
     p.bias_integral_y += static_cast<float>(shift.y() * p.bias_time);
-    // Velocity, dwell and side memory stay: the hypothesis is the same walk one lane over.
   }
+  // Velocity, dwell and side memory stay: the hypothesis is the same walk one lane over.
+}
+
+bool TopologicalParticleFilter::moveTowardsLaneEvidence() {
+  // Resample-move (Gilks and Berzuini 2001; tpf_params.h, lane_evidence_sensors): the particles stand for the
+  // posterior after weighting; each sweep proposes the swap move for every particle and accepts with
+  // min(1, L(n') / L(n) x the device prior ratio), which leaves the posterior invariant and carries mass into
+  // a lane no particle held. L is node_scratch_a_ (the observation's likelihood, 0 off its nodes).
+  if (graph_->across.empty()) return false;
+  const bool prior = bias_prior_variance_ > 1e-6;
+  const double inv_two_p = prior ? 0.5 / bias_prior_variance_ : 0.0;
+  const double inv_four_p_tau = prior && bias_drift_rate_ > 0.0
+                                    ? bias_drift_rate_ / (8.0 * bias_prior_variance_ * bias_prior_variance_)
+                                    : 0.0;
+  bool moved = false;
+  for (int sweep = 0; sweep < params_.lane_evidence_sweeps; ++sweep)
+    for (Particle& p : particles_) {
+      if (p.lane_change != 0) continue;
+      const NodeIndex to = graph_->across[2 * p.node + (rng_() & 1u)];
+      if (to == topology::kInvalidNode) continue;
+      const double l_from = node_scratch_a_[p.node], l_to = node_scratch_a_[to];
+      if (!(l_to > 0.0)) continue;
+      const Eigen::Vector2d shift = map_->position2d(p.node) - map_->position2d(to);
+      double log_ratio = l_from > 0.0 ? std::log(l_to / l_from) : std::numeric_limits<double>::infinity();
+      if (prior && p.bias_variance >= 0.0f)
+        log_ratio += swapLogPriorRatio(p, shift, bias_prior_mean_, inv_two_p, inv_four_p_tau);
+      if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
+      applySwap(p, to, shift);
+      moved = true;
+    }
+  return moved;
 }
 
 void TopologicalParticleFilter::resample(double total) {
@@ -1129,21 +1184,29 @@ TopologicalParticleFilter TopologicalParticleFilter::copyWithSeed(std::uint64_t 
   return copy;
 }
 
-Belief TopologicalParticleFilter::predictAhead(double seconds, std::uint64_t seed) const {
+TopologicalParticleFilter TopologicalParticleFilter::predictedCopy(double seconds, std::uint64_t seed) const {
   TopologicalParticleFilter copy = copyWithSeed(seed);
   if (std::isfinite(seconds) && seconds > 0.0) copy.predictTo(belief_.stamp + seconds);
+  return copy;
+}
+
+Belief TopologicalParticleFilter::predictAhead(double seconds, std::uint64_t seed) const {
+  return predictedCopy(seconds, seed).belief_;
+}
+
+Belief TopologicalParticleFilter::posteriorNow(const core::Observation& hypothetical,
+                                               UpdateResult* result) const {
+  TopologicalParticleFilter copy = *this;
+  core::Observation obs = hypothetical;
+  obs.stamp = belief_.stamp;
+  const UpdateResult r = copy.update(obs);
+  if (result) *result = r;
   return copy.belief_;
 }
 
 Belief TopologicalParticleFilter::posteriorUnder(const core::Observation& hypothetical, double seconds,
                                                  std::uint64_t seed, UpdateResult* result) const {
-  TopologicalParticleFilter copy = copyWithSeed(seed);
-  if (std::isfinite(seconds) && seconds > 0.0) copy.predictTo(belief_.stamp + seconds);
-  core::Observation obs = hypothetical;
-  obs.stamp = copy.belief_.initialised ? copy.belief_.stamp : belief_.stamp;
-  const UpdateResult r = copy.update(obs);
-  if (result) *result = r;
-  return copy.belief_;
+  return predictedCopy(seconds, seed).posteriorNow(hypothetical, result);
 }
 
 }  // namespace tpf

@@ -42,6 +42,11 @@ bool TpfParams::usesBiasState(const std::string& sensor) const {
          std::find(gnss_bias_sensors.begin(), gnss_bias_sensors.end(), sensor) != gnss_bias_sensors.end();
 }
 
+bool TpfParams::isLaneEvidence(const std::string& sensor) const {
+  return lane_evidence_sweeps > 0 && std::find(lane_evidence_sensors.begin(), lane_evidence_sensors.end(),
+                                               sensor) != lane_evidence_sensors.end();
+}
+
 std::string TpfParams::validate() const {
   auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0.0; };
   if (num_particles == 0 || num_particles > kMaxParticles)
@@ -98,6 +103,8 @@ std::string TpfParams::validate() const {
     return core::badValue("lane_swap_max_distance", lane_swap_max_distance, "in (0, 20] m");
   if (!(lane_swap_memory > 0.0 && lane_swap_memory <= 86400.0))
     return core::badValue("lane_swap_memory", lane_swap_memory, "in (0, 86400] s");
+  if (lane_evidence_sweeps < 0 || lane_evidence_sweeps > 50)
+    return core::badValue("lane_evidence_sweeps", lane_evidence_sweeps, "in [0, 50]");
   return "";
 }
 
@@ -186,6 +193,8 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "lane_swap_rate",
                                                 "lane_swap_max_distance",
                                                 "lane_swap_memory",
+                                                "lane_evidence_sensors",
+                                                "lane_evidence_sweeps",
                                                 "map_node_by_lane",
                                                 "resampling",
                                                 "motion_model",
@@ -258,6 +267,8 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "lane_swap_rate", p.lane_swap_rate);
   read(node, "lane_swap_max_distance", p.lane_swap_max_distance);
   read(node, "lane_swap_memory", p.lane_swap_memory);
+  read(node, "lane_evidence_sensors", p.lane_evidence_sensors);
+  read(node, "lane_evidence_sweeps", p.lane_evidence_sweeps);
   read(node, "map_node_by_lane", p.map_node_by_lane);
   if (node["method"]) {  // mode switches win
     try {

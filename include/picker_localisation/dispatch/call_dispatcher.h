@@ -88,6 +88,11 @@ struct Goal {
   CallState state = CallState::kAssigned;  // the call's state the goal belongs to
 };
 
+// One call as a line of a farm's call log (CSV; times are the stamps given, s; empty: not reached):
+// callLogHeader() names the columns. The node's `calls_log` file and the live-graph benchmark read it.
+std::string callLogHeader();
+std::string callLogLine(const Call& call, const topology::TopologicalMap& map);
+
 // The storage node a farm without one configured gets: the node outside every lane nearest the map's
 // lower-left corner ("" for a map whose nodes are all in lanes). The runner and the dispatcher node alike.
 std::string defaultStorageNode(const topology::TopologicalMap& map);

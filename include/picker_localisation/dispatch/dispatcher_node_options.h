@@ -36,6 +36,9 @@ struct DispatcherNodeOptions {
   bool forward_fix = true;          // a call's fix goes on the picker's GNSS topic (a CAR app's only fix)
   double row_evidence_floor = 0.2;  // likelihood outside the reported row (1 inside); 1: the row is not used
   int closed_calls_kept = 20;       // done / cancelled calls still published on ~status
+  // A farm's record of its calls: a CSV file, one line per call when it closes (done or cancelled) and for
+  // the calls still open when the node stops ("" none). Columns: callLogHeader().
+  std::string calls_log;
   std::string datum_file;           // for a call's fix when the map has no datum
   std::string datum_source = "auto";  // auto | file | map (as gnss_ingest)
   DispatcherOptions dispatcher;

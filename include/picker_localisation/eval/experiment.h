@@ -8,9 +8,9 @@
 //   single      1 picker, 1 robot  (Table II "Single picker")
 //   navigation  1 picker, 1 robot  (Table II "Navigation Strategy")
 //   multi       3 pickers, 1 robot (Table II "Multiple pickers")
-//   calls       `pickers` pickers fill trays and call, `robots` robots answer (dispatch::CallDispatcher);
-//   scored
-//               per call: call-to-arrival time, wrong-lane entries, false arrivals, metres driven
+//   calls       `pickers` pickers fill trays and call, `robots` robots answer (dispatch::CallDispatcher),
+//               robots serving no call positioned by the Next-Best-Sense planner (RunConfig::idle_robots);
+//               scored per call: call-to-arrival time, wrong-lane entries, false arrivals, metres driven
 // The robot patrols the lanes (simulator patrol `lanes`) unless the method is a navigation policy
 // (estimated_node, nbs), whose planner then sets the robot's goals.
 // A method whose components are not in this build (or whose data file is missing) is reported unavailable
@@ -65,6 +65,10 @@ struct RunConfig {
   std::size_t pickers = 30;        // calls scenario: pickers (ids picker_<i>; config/pickers.yaml's first)
   std::size_t robots = 10;         // calls scenario: robots (about 1 robot : 3 pickers)
   std::string dispatcher_config;   // calls scenario: dispatch::DispatcherOptions, config/dispatcher.yaml
+  // calls scenario: what a robot serving no call does. "nbs": the Next-Best-Sense planner (config/nbs.yaml,
+  // policy nbs) positions it over the trackers' beliefs, as nbs_planner does in the ROS graph, with the
+  // goals of the other robots (a served call's target included) as claims; "stay": it waits where it is.
+  std::string idle_robots = "nbs";
   std::uint64_t tracker_seed = 0;  // 0: trackers seeded from `seed`; else each from its picker id mixed with
                                    // this, as tpf_tracker with ~seed (tpf::TrackerFleet::seedFor)
 };
@@ -101,6 +105,7 @@ struct CallRecord {
 
 struct RunResult {
   std::vector<CallRecord> calls;  // calls scenario
+  std::size_t idle_goals = 0;     // calls scenario: goals the planner gave robots serving no call
   std::vector<ErrorSample> samples;
   std::vector<BiasSample> bias_samples;
   std::size_t observations = 0;  // observations given to trackers

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include "picker_localisation/nbs/belief_source.h"
@@ -28,9 +29,18 @@ class TpfBeliefSource : public BeliefSource {
   NodeMasses posterior(double horizon, const core::Observation& obs) override;
 
  private:
+  // The filter predicted to a horizon, shared by the hypotheses asked at that horizon (one prediction per
+  // horizon, as the planner buckets them); dropped when the live filter changed (another update or
+  // prediction) and bounded in size, so a long-lived source does not grow.
+  const tpf::TopologicalParticleFilter& predictedFilter(double horizon);
+
   std::string id_;
   const tpf::TopologicalParticleFilter* filter_;
   std::uint64_t seed_;
+  std::uint64_t cached_version_ = 0;
+  double cached_stamp_ = 0.0;
+  const topology::TopologicalMap* cached_map_ = nullptr;
+  std::map<double, tpf::TopologicalParticleFilter> predicted_;
 };
 
 }  // namespace nbs

@@ -29,9 +29,11 @@
 #include <picker_localisation/RfidReading.h>
 #include <std_msgs/String.h>
 
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,7 @@ namespace ros_adapter {
 class DispatcherNode {
  public:
   DispatcherNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+  ~DispatcherNode();  // the calls still open go to ~calls_log
   bool ok() const { return static_cast<bool>(dispatcher_); }
   // One dispatcher update at ROS time `now` (the timer calls it). Public for tests.
   void update(const ros::Time& now);
@@ -80,6 +83,7 @@ class DispatcherNode {
   void freeRobot(const std::string& robot, const ros::Time& stamp);
   picker_localisation::CallStatus statusOf(const dispatch::Call& call) const;
   void publishStatus(const ros::Time& stamp);
+  void logClosedCalls();  // ~calls_log: every call closed since the last time, once
   void publishMarkers(const ros::Time& stamp);
   void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
   void refuse(const std::string& input, const std::string& why);
@@ -107,6 +111,8 @@ class DispatcherNode {
   std::size_t calls_taken_ = 0, calls_refused_ = 0, cancels_ = 0, arrivals_ = 0, beliefs_rejected_ = 0,
               pose_failures_ = 0, goals_sent_ = 0;
   std::string last_refusal_;
+  std::ofstream calls_log_;
+  std::set<std::uint64_t> logged_calls_;
 };
 
 }  // namespace ros_adapter

@@ -161,8 +161,14 @@ class TopologicalParticleFilter {
   // --- what-if (planner): work on a copy, the live filter is untouched ------------------------------------
   // A copy whose generator is re-seeded with `seed` (0: the copy keeps the live generator's state).
   TopologicalParticleFilter copyWithSeed(std::uint64_t seed) const;
+  // A copy re-seeded with `seed` and predicted `seconds` (>= 0) beyond the last update: where predictAhead
+  // and posteriorUnder start from (a planner asking several hypotheses at one horizon predicts once).
+  TopologicalParticleFilter predictedCopy(double seconds, std::uint64_t seed = 0) const;
   // Belief after predicting `seconds` (>= 0) beyond the last update.
   Belief predictAhead(double seconds, std::uint64_t seed = 0) const;
+  // Belief after fusing `hypothetical` into a copy of this filter at its last stamp (the observation's stamp
+  // is ignored): posteriorUnder without the prediction, for a predictedCopy().
+  Belief posteriorNow(const core::Observation& hypothetical, UpdateResult* result = nullptr) const;
   // Belief after predicting `seconds` ahead and fusing `hypothetical` at that time (its stamp is ignored).
   // An invalid hypothetical observation returns the predicted belief; `result` (optional) tells why.
   Belief posteriorUnder(const core::Observation& hypothetical, double seconds = 0.0, std::uint64_t seed = 0,
@@ -208,6 +214,15 @@ class TopologicalParticleFilter {
   // Lane hypotheses kept alive after resampling on a GNSS fix with the bias state
   // (TpfParams::lane_swap_rate).
   void swapLanes(const core::Observation& obs);
+  // Lane evidence (TpfParams::lane_evidence_sensors): lane_evidence_sweeps Metropolis-Hastings sweeps of the
+  // swap move with the observation's likelihood (node_scratch_a_) in the acceptance. True when a particle
+  // moved.
+  bool moveTowardsLaneEvidence();
+  // log of the device prior's density ratio for shifting a particle's bias (and its recent path) by `shift`.
+  double swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift, const Eigen::Vector2d& prior_mean,
+                           double inv_two_p, double inv_four_p_tau) const;
+  // Moves a particle to `to` with its bias (and bias path) shifted by `shift`.
+  static void applySwap(Particle& p, topology::NodeIndex to, const Eigen::Vector2d& shift);
   void resample(double total_weight);
   void chooseMapNodeByLane();  // TpfParams::map_node_by_lane
   void addNoise();
@@ -237,6 +252,11 @@ class TopologicalParticleFilter {
   // s, last observation of a sensor without the bias state (-inf: none)
   double other_sensor_stamp_ = -std::numeric_limits<double>::infinity();
   double bias_fix_variance_ = 1.0;  // m^2, R of the bias state's fix model (constructor)
+  // The device model of the last fix with the bias state (mean m, per-axis variance P, drift rate Q): what a
+  // lane-evidence move weighs the shifted bias with (P 0: none yet, the likelihood alone decides).
+  Eigen::Vector2d bias_prior_mean_ = Eigen::Vector2d::Zero();
+  double bias_prior_variance_ = 0.0;
+  double bias_drift_rate_ = 0.0;
   Belief belief_;
   FilterCounters counters_;
 };
