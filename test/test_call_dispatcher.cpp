@@ -108,16 +108,23 @@ TEST(CallDispatcher, ArrivalOnlyFromTheServingRobotsOwnSightingThenLoadingStorag
   d.setRobotNode("robot_1", node(*map, "H0"));
   d.update(60.0);
   EXPECT_EQ(d.find(id)->state, CallState::kDone);
+  EXPECT_DOUBLE_EQ(d.find(id)->done_at, 60.0);
+  EXPECT_EQ(d.servedBy("robot_1"), nullptr);
   // The farm's call log line: every time the call passed, the wait from call to arrival, the last target.
   EXPECT_EQ(
       dispatch::callLogHeader(),
       "call_id,picker_id,robot_id,state,called,assigned,arrived,loaded,done,call_to_arrival_s,target_node");
   EXPECT_EQ(dispatch::callLogLine(*d.find(id), *map),
             std::to_string(id) + ",picker_1,robot_1,done,10,10,22,52,60,12,H0");
+  // A sighting stamped before the call (the robot stood by the picker when it called) is arrival at the call.
+  d.setRobotNode("robot_1", node(*map, "r3_2"));
+  const auto early = *d.call("picker_1", 65.0);
+  d.update(65.0);
+  ASSERT_EQ(d.find(early)->robot_id, "robot_1");
+  EXPECT_TRUE(d.sighting("robot_1", "picker_1", 64.8, 0.5));
+  EXPECT_DOUBLE_EQ(d.find(early)->arrived_at, 65.0);
   const auto open = *d.call("picker_2", 70.0);
   EXPECT_EQ(dispatch::callLogLine(*d.find(open), *map), std::to_string(open) + ",picker_2,,queued,70,,,,,,");
-  EXPECT_DOUBLE_EQ(d.find(id)->done_at, 60.0);
-  EXPECT_EQ(d.servedBy("robot_1"), nullptr);
 }
 
 TEST(CallDispatcher, QueuedWithoutBeliefOrFreeRobotOneRobotPerCallCancelAndRefusals) {

@@ -198,7 +198,9 @@ bool CallDispatcher::sighting(const std::string& robot_id, const std::string& pi
         !(distance <= options_.arrival_distance))
       return false;
     c.state = CallState::kArrived;
-    c.arrived_at = stamp;
+    // A sighting stamped just before the call (the robot was already at the picker; messages cross) is
+    // arrival at the call.
+    c.arrived_at = std::max(stamp, c.stamp);
     return true;
   }
   return false;

@@ -518,7 +518,8 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
 void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by) {
   OpenCall& c = open_calls_.at(call_id);
   c.arrived = true;
-  c.record.arrival_s = stamp - c.record.stamp;
+  c.record.arrival_s =
+      dispatcher_->find(call_id)->arrived_at - c.record.stamp;  // as the dispatcher declared it
   c.record.arrival_distance =
       (simulator_.robotPose(robot).position() - simulator_.pickerPose(c.picker).position()).norm();
   c.record.false_arrival = c.record.arrival_distance > 3.0;
