@@ -30,6 +30,15 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
+// The package's config/sim.yaml with the call scenario's mean tray time set, written into `dir`.
+std::string simWithTrayTime(const fs::path& dir, double tray_time_mean) {
+  const std::string sim = (dir / "sim_calls.yaml").string();
+  YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
+  y["calls"]["tray_time_mean"] = tray_time_mean;
+  std::ofstream(sim) << y;
+  return sim;
+}
+
 // Writes the synthetic polytunnel as a tmap2 file (nodes, poses, edges, row tags).
 std::string writeSyntheticTmap2(const fs::path& dir) {
   topology::PolytunnelSpec spec;
@@ -253,12 +262,7 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
   // answered, none falsely; the raw fix's node sends robots into lanes the picker is not in. summary.csv has
   // the call columns.
   const fs::path dir = tempDir("calls");
-  const std::string sim = (dir / "sim_calls.yaml").string();
-  {
-    YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
-    y["calls"]["tray_time_mean"] = 120.0;
-    std::ofstream(sim) << y;
-  }
+  const std::string sim = simWithTrayTime(dir, 120.0);
   ExperimentConfig c;
   c.map_path = std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2";
   c.scenario = Scenario::kCalls;
@@ -305,13 +309,7 @@ TEST(Experiment, IdleRobotsArePositionedByThePlanner) {
   // Nobody calls (trays take hours): every robot is idle. With idle_robots "nbs" the planner sends them
   // where their sensors tell most about the pickers, as nbs_planner does in the ROS graph, so they see and
   // identify more pickers than robots waiting where they started; with "stay" no goal is given.
-  const fs::path dir = tempDir("idle");
-  const std::string sim = (dir / "sim_idle.yaml").string();
-  {
-    YAML::Node y = YAML::LoadFile(resolveConfigFile("", "sim.yaml"));
-    y["calls"]["tray_time_mean"] = 1.0e6;
-    std::ofstream(sim) << y;
-  }
+  const std::string sim = simWithTrayTime(tempDir("idle"), 1.0e6);
   auto map = std::make_shared<const topology::TopologicalMap>(
       topology::loadMap(std::string(PL_PACKAGE_DIR) + "/config/maps/riseholme.tmap2"));
   RunConfig rc;

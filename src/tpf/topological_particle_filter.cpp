@@ -964,20 +964,15 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
   // which predicts every fix as b did; accepted with min(1, N(b'; m, P) / N(b; m, P)), the device prior of
   // the fix. The proposal is symmetric where the lanes' nodes face each other (evenly spaced parallel lanes);
   // where they are staggered it is nearly so.
-  const double prior_variance = 0.5 * obs.bias_covariance.trace();
-  if (graph_->across.empty() || bias_step_ <= 0.0 || !(prior_variance > 1e-6)) return;
+  // The device prior is the fix's own: weighWithBiasState() stored it for this observation.
+  const SwapPrior prior = swapPrior();
+  if (graph_->across.empty() || bias_step_ <= 0.0 || !prior.known()) return;
   // Another sensor (a robot's LiDAR, RFID, UWB) told the lane recently: that evidence is not in the bias path
   // the acceptance weighs, so swaps would undo it (measured: Table II rows with robot sensing lost
   // 0.08-0.10).
   if (obs.stamp - other_sensor_stamp_ < params_.lane_swap_memory) return;
   const double propose = -std::expm1(-params_.lane_swap_rate * bias_step_);
   if (!(propose > 0.0)) return;
-  const Eigen::Vector2d m = *obs.bias_removed;
-  const double inv_two_p = 0.5 / prior_variance;
-  // Path term: shifting the whole recent bias path by d changes the Gauss-Markov path density by
-  // -(2 d.A + |d|^2 T) / (4 P tau), A = integral of (b - m) dt, T = integral of dt, tau = 2 P / Q.
-  const double inv_four_p_tau =
-      obs.bias_drift_rate > 0.0 ? obs.bias_drift_rate / (8.0 * prior_variance * prior_variance) : 0.0;
   std::geometric_distribution<std::size_t> gap(std::min(propose, 1.0));
   for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
     Particle& p = particles_[i];
@@ -985,19 +980,30 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
     const NodeIndex to = graph_->across[2 * p.node + (rng_() & 1u)];
     if (to == topology::kInvalidNode) continue;
     const Eigen::Vector2d shift = map_->position2d(p.node) - map_->position2d(to);
-    const double log_ratio = swapLogPriorRatio(p, shift, m, inv_two_p, inv_four_p_tau);
+    const double log_ratio = swapLogPriorRatio(p, shift, prior);
     if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
     applySwap(p, to, shift);
   }
 }
 
+TopologicalParticleFilter::SwapPrior TopologicalParticleFilter::swapPrior() const {
+  SwapPrior prior;
+  if (!(bias_prior_variance_ > 1e-6)) return prior;  // no fix with a prior yet
+  prior.mean = bias_prior_mean_;
+  prior.inv_two_p = 0.5 / bias_prior_variance_;
+  // Path term: shifting the whole recent bias path by d changes the Gauss-Markov path density by
+  // -(2 d.A + |d|^2 T) / (4 P tau), A = integral of (b - m) dt, T = integral of dt, tau = 2 P / Q.
+  if (bias_drift_rate_ > 0.0)
+    prior.inv_four_p_tau = bias_drift_rate_ / (8.0 * bias_prior_variance_ * bias_prior_variance_);
+  return prior;
+}
+
 double TopologicalParticleFilter::swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift,
-                                                    const Eigen::Vector2d& prior_mean, double inv_two_p,
-                                                    double inv_four_p_tau) const {
+                                                    const SwapPrior& prior) const {
   const Eigen::Vector2d b(p.bias_x, p.bias_y), moved = b + shift;
   const Eigen::Vector2d integral(p.bias_integral_x, p.bias_integral_y);
-  return ((b - prior_mean).squaredNorm() - (moved - prior_mean).squaredNorm()) * inv_two_p -
-         (2.0 * shift.dot(integral) + shift.squaredNorm() * p.bias_time) * inv_four_p_tau;
+  return ((b - prior.mean).squaredNorm() - (moved - prior.mean).squaredNorm()) * prior.inv_two_p -
+         (2.0 * shift.dot(integral) + shift.squaredNorm() * p.bias_time) * prior.inv_four_p_tau;
 }
 
 void TopologicalParticleFilter::applySwap(Particle& p, NodeIndex to, const Eigen::Vector2d& shift) {
@@ -1017,11 +1023,7 @@ bool TopologicalParticleFilter::moveTowardsLaneEvidence() {
   // min(1, L(n') / L(n) x the device prior ratio), which leaves the posterior invariant and carries mass into
   // a lane no particle held. L is node_scratch_a_ (the observation's likelihood, 0 off its nodes).
   if (graph_->across.empty()) return false;
-  const bool prior = bias_prior_variance_ > 1e-6;
-  const double inv_two_p = prior ? 0.5 / bias_prior_variance_ : 0.0;
-  const double inv_four_p_tau = prior && bias_drift_rate_ > 0.0
-                                    ? bias_drift_rate_ / (8.0 * bias_prior_variance_ * bias_prior_variance_)
-                                    : 0.0;
+  const SwapPrior prior = swapPrior();
   bool moved = false;
   for (int sweep = 0; sweep < params_.lane_evidence_sweeps; ++sweep)
     for (Particle& p : particles_) {
@@ -1032,8 +1034,7 @@ bool TopologicalParticleFilter::moveTowardsLaneEvidence() {
       if (!(l_to > 0.0)) continue;
       const Eigen::Vector2d shift = map_->position2d(p.node) - map_->position2d(to);
       double log_ratio = l_from > 0.0 ? std::log(l_to / l_from) : std::numeric_limits<double>::infinity();
-      if (prior && p.bias_variance >= 0.0f)
-        log_ratio += swapLogPriorRatio(p, shift, bias_prior_mean_, inv_two_p, inv_four_p_tau);
+      if (prior.known() && p.bias_variance >= 0.0f) log_ratio += swapLogPriorRatio(p, shift, prior);
       if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
       applySwap(p, to, shift);
       moved = true;

@@ -218,9 +218,16 @@ class TopologicalParticleFilter {
   // swap move with the observation's likelihood (node_scratch_a_) in the acceptance. True when a particle
   // moved.
   bool moveTowardsLaneEvidence();
+  // The device prior both lane moves weigh a shifted bias with (the last fix with the bias state): its mean,
+  // 1 / 2P and the path term's Q / 8P^2; all 0 before such a fix.
+  struct SwapPrior {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double inv_two_p = 0.0, inv_four_p_tau = 0.0;
+    bool known() const { return inv_two_p > 0.0; }
+  };
+  SwapPrior swapPrior() const;
   // log of the device prior's density ratio for shifting a particle's bias (and its recent path) by `shift`.
-  double swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift, const Eigen::Vector2d& prior_mean,
-                           double inv_two_p, double inv_four_p_tau) const;
+  double swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift, const SwapPrior& prior) const;
   // Moves a particle to `to` with its bias (and bias path) shifted by `shift`.
   static void applySwap(Particle& p, topology::NodeIndex to, const Eigen::Vector2d& shift);
   void resample(double total_weight);
@@ -252,8 +259,8 @@ class TopologicalParticleFilter {
   // s, last observation of a sensor without the bias state (-inf: none)
   double other_sensor_stamp_ = -std::numeric_limits<double>::infinity();
   double bias_fix_variance_ = 1.0;  // m^2, R of the bias state's fix model (constructor)
-  // The device model of the last fix with the bias state (mean m, per-axis variance P, drift rate Q): what a
-  // lane-evidence move weighs the shifted bias with (P 0: none yet, the likelihood alone decides).
+  // The device model of the last fix with the bias state (mean m, per-axis variance P, drift rate Q): what
+  // the lane swaps and a lane-evidence move weigh the shifted bias with (P 0: none yet).
   Eigen::Vector2d bias_prior_mean_ = Eigen::Vector2d::Zero();
   double bias_prior_variance_ = 0.0;
   double bias_drift_rate_ = 0.0;
