@@ -6,7 +6,7 @@
 # Environment: BUILD_DIR (build), METHODS (the scenario's default rows), FARMS ("riseholme long_lanes"),
 # DISPATCHER_CONFIG (config/dispatcher.yaml), SIM_CONFIG (config/sim.yaml: e.g. calls.reported_row_share), JOBS (2),
 # IDLE_ROBOTS (nbs: the planner positions robots serving no call, as nbs_planner does; stay: they wait),
-# SEED (1: runs use seeds SEED .. SEED + RUNS - 1).
+# SEED (1: runs use seeds SEED .. SEED + RUNS - 1), TPF_CONFIG (config/tpf.yaml).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 RUNS="${1:-5}"
@@ -25,6 +25,7 @@ for farm in $FARMS; do
   "$BUILD_DIR/devel/lib/picker_localisation/experiment" --map "$OUT/$farm.tmap2" --scenario calls --runs "$RUNS" \
     --seed "${SEED:-1}" --duration "$DURATION" --pickers-count "$PICKERS" --robots "$ROBOTS" --methods "$METHODS" \
     --dispatcher-config "${DISPATCHER_CONFIG:-config/dispatcher.yaml}" --sim-config "${SIM_CONFIG:-config/sim.yaml}" \
+    --tpf-config "${TPF_CONFIG:-config/tpf.yaml}" \
     --idle-robots "${IDLE_ROBOTS:-nbs}" --jobs "${JOBS:-2}" --out "$OUT/$farm" \
     > "$OUT/$farm.log" 2>&1 || { echo "experiment failed: $OUT/$farm.log" >&2; exit 1; }
   cat "$OUT/$farm/summary.md"

@@ -31,6 +31,7 @@ NodeIndex node(const topology::TopologicalMap& map, const std::string& name) {
 
 DispatcherOptions options() {
   DispatcherOptions o;
+  o.commit_share = 0.0;  // the 1-median alone; committing to a lane has its own test
   o.load_time = 30.0;
   o.storage_node = "H0";
   return o;

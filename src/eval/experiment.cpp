@@ -575,6 +575,8 @@ void GraphRun::dispatchCalls(double now) {
       c.robot_node = simulator_.robot(r).currentNode();
       // A robot already in a lane (an idle robot the planner sent there) leaving it has not entered it.
       c.inside = map_->lane(c.robot_node);
+      c.record.first_target_in_picker_lane =
+          map_->lane(g.node) != topology::kNoLane && map_->lane(g.node) == simulator_.pickerLane(c.picker);
     }
   }
   for (auto it = open_calls_.begin(); it != open_calls_.end();) {
@@ -590,8 +592,11 @@ void GraphRun::dispatchCalls(double now) {
       if (node != c.robot_node) {
         const topology::LaneIndex lane =
             map_->lane(node) == map_->lane(c.robot_node) ? map_->lane(node) : topology::kNoLane;
-        if (lane != c.inside && lane != topology::kNoLane && lane != simulator_.pickerLane(c.picker))
+        if (lane != c.inside && lane != topology::kNoLane && lane != simulator_.pickerLane(c.picker)) {
           ++c.record.wrong_lane_entries;
+          if (call.target == topology::kInvalidNode || map_->lane(call.target) != lane)
+            ++c.record.through_lane_entries;
+        }
         c.inside = lane;
         c.robot_node = node;
       }
@@ -936,13 +941,13 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     std::vector<std::vector<ErrorSample>> samples;
     for (std::size_t k = 0; k < config.runs && config.scenario == Scenario::kCalls; ++k) {
       std::ofstream calls(fs::path(config.out_dir) / method / ("calls_" + std::to_string(k) + ".csv"));
-      calls
-          << "picker_id,stamp,arrival_s,wrong_lane_entries,false_arrival,arrival_distance,arrived_by,metres,"
-             "reported_row\n";
+      calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
+               "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row\n";
       for (const CallRecord& c : runs[k].calls)
         calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
-              << c.false_arrival << "," << c.arrival_distance << "," << c.arrived_by << "," << c.metres << ","
-              << c.reported_row << "\n";
+              << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival
+              << "," << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row
+              << "\n";
     }
     for (std::size_t k = 0; k < config.runs; ++k) {
       writeRunCsv((fs::path(config.out_dir) / method / ("run_" + std::to_string(k) + ".csv")).string(), *map,

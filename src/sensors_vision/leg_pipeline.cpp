@@ -224,7 +224,6 @@ std::vector<TrackedPerson> LegPipeline::track(const std::string& source_frame, d
     t.confidence = fused[i].confidence;
     t.track_id = track_of[i];
     t.camera_confirmed = cam;
-    camera_confirmed_ += cam ? 1 : 0;
     out.push_back(std::move(t));
   }
   return out;

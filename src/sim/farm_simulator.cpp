@@ -232,9 +232,6 @@ std::optional<std::size_t> FarmSimulator::robotIndex(const std::string& id) cons
 void FarmSimulator::setRobotGoal(std::size_t r, NodeIndex goal) {
   robots_.at(r).setGoal(goal);
 }
-void FarmSimulator::clearRobotGoal(std::size_t r) {
-  robots_.at(r).clearGoal();
-}
 
 LaserScene FarmSimulator::laserScene(std::size_t r) const {
   LaserScene scene;

@@ -96,6 +96,9 @@ struct CallRecord {
   double stamp = 0.0;                  // s, when the picker called
   double arrival_s = 0.0;              // s from the call to the arrival (+inf: not arrived by the run's end)
   std::size_t wrong_lane_entries = 0;  // lanes the serving robot drove into that the picker was not in
+  // Of those, lanes that were not the target's lane then: the route to the target passed through them.
+  std::size_t through_lane_entries = 0;
+  bool first_target_in_picker_lane = false;  // the first goal the dispatcher gave was in the picker's lane
   bool false_arrival = false;          // arrival declared with the picker more than 3 m from the robot
   double arrival_distance = 0.0;       // m, robot to picker when the arrival was declared (truth)
   std::string arrived_by;              // "rfid" or "lidar": the sensing that declared the arrival

@@ -69,7 +69,6 @@ class FarmSimNode {
   void run();
   // One tick: advance the simulation by ~clock_step and publish. Exposed for tests.
   void tick();
-  double simTime() const { return sim_ ? sim_->time() : 0.0; }
 
  private:
   struct RobotIo {

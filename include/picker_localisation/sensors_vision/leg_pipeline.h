@@ -133,7 +133,6 @@ class LegPipeline {
     fusion_.reset();
     last_negative_.clear();
   }
-  std::size_t cameraConfirmed() const { return camera_confirmed_; }
 
  private:
   LegPipelineOptions options_;
@@ -141,7 +140,6 @@ class LegPipeline {
   std::map<std::string, ClusterTracker> trackers_;
   std::map<std::string, double> last_negative_;  // frame -> stamp of its last negative observation
   LidarCameraFusion fusion_;
-  std::size_t camera_confirmed_ = 0;
 };
 
 }  // namespace vision

@@ -124,7 +124,6 @@ class FarmSimulator {
   topology::NodeIndex pickerNearestNode(std::size_t i) const;
   topology::LaneIndex pickerLane(std::size_t i) const;
   std::optional<std::size_t> pickerIndex(const std::string& id) const;
-  const GnssErrorModel& gnssModel(std::size_t i) const { return gnss_.at(i); }
 
   std::size_t numRobots() const { return robots_.size(); }
   const SimulatedRobot& robot(std::size_t r) const { return robots_.at(r); }
@@ -136,7 +135,6 @@ class FarmSimulator {
   void releasePicker(std::size_t i);
   // Retargets robot r to a goal node (any time). Throws std::out_of_range on a bad index or node.
   void setRobotGoal(std::size_t r, topology::NodeIndex goal);
-  void clearRobotGoal(std::size_t r);
 
   // Static clutter (bed posts) in the map frame.
   const std::vector<Circle>& posts() const { return posts_; }

@@ -154,7 +154,6 @@ class TopologicalParticleFilter {
   const std::vector<Particle>& particles() const { return particles_; }
   const TpfParams& params() const { return params_; }
   const topology::TopologicalMap& map() const { return *map_; }
-  std::shared_ptr<const topology::TopologicalMap> mapPtr() const { return map_; }
   bool initialised() const { return belief_.initialised; }
   double lastStamp() const { return belief_.stamp; }
 
