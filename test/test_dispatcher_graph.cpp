@@ -70,12 +70,23 @@ TEST(DispatcherGraph, ACallGoesFromQueuedToDoneOnSensedArrival) {
   const std::vector<std::string>& seen = g_states[done_call];
   std::string joined;
   for (const auto& s : seen) joined += s + " ";
-  // Every state in order; each shows at least once (the status goes out at every change).
-  EXPECT_EQ(seen, order) << joined;
+  // Every state in order; each shows at least once (the status goes out at every change). A robot the planner
+  // had already put beside the caller may sense it before the update that marks the call on its way: then the
+  // call goes from assigned straight to arrived, and only then.
+  std::vector<std::string> without_on_the_way = order;
+  without_on_the_way.erase(without_on_the_way.begin() + 2);
+  const auto& last = g_last[done_call];
+  const bool arrived_at_once =
+      (last.arrived - last.assigned).toSec() <= 1.5;  // within one update (1 s) or so
+  if (seen == without_on_the_way)
+    EXPECT_TRUE(arrived_at_once) << "on_the_way skipped though the arrival came "
+                                 << (last.arrived - last.assigned).toSec() << " s after the assignment";
+  else
+    EXPECT_EQ(seen, order) << joined;
   const auto& c = g_last[done_call];
   EXPECT_FALSE(c.robot_id.empty());
   EXPECT_LE(c.called.toSec(), c.assigned.toSec());
-  EXPECT_LT(c.assigned.toSec(), c.arrived.toSec());
+  EXPECT_LE(c.assigned.toSec(), c.arrived.toSec());  // equal: sensed in the update that assigned it
   EXPECT_LT(c.arrived.toSec(), c.done.toSec());
   ASSERT_TRUE(g_arrival_distance.count(done_call));
   EXPECT_LE(g_arrival_distance[done_call], 3.0)
