@@ -35,7 +35,7 @@ for f in missing_target bad_number empty scalar nonexistent; do
 done
 printf '%s\n' "$("$bin" "$tmp/missing_target.tmap2" 2>&1)" | grep -q "node 'A'" || { echo "FAIL: node name missing"; fail=1; }
 printf '%s\n' "$("$bin" "$tmp/bad_number.tmap2" 2>&1)" | grep -q "node.pose.position.x" || { echo "FAIL: field missing"; fail=1; }
-# Issue 17: a device never ends (tmap_info /dev/zero hung), a directory is no map, a 2 MB token must not be echoed.
+# Bad inputs: a device never ends (tmap_info /dev/zero hung), a directory is no map, a 2 MB token must not be echoed.
 python3 -c "print('nodes:\n- node: {name: A, pose: {position: {x: ' + 'x' * 2000000 + ', y: 0}}}')" > "$tmp/long_token.tmap2"
 mkdir -p "$tmp/a_directory"
 for f in /dev/zero "$tmp/a_directory" "$tmp/long_token.tmap2"; do
@@ -47,7 +47,7 @@ for f in /dev/zero "$tmp/a_directory" "$tmp/long_token.tmap2"; do
     echo "ok: $f -> rc 2: $out"
   fi
 done
-# Issue 13: rosrun finds the tool after `make` (rosrun skips every path below <package>/build/, so the devel space
+# rosrun finds the tool after `make` (rosrun skips every path below <package>/build/, so the devel space
 # must live outside it: make puts it in build-devel/). The third argument is the devel space of this build.
 devel="${3:-}"
 if [ -n "$devel" ]; then

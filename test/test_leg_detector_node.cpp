@@ -140,8 +140,8 @@ TEST(LegDetectorNode, RealScansEmptyScanAndMissingTf) {
     std::fill(s.ranges.begin(), s.ranges.end(), std::numeric_limits<float>::infinity());
   });
   sendScan(1, "no_such_laser", ros::Time::now());
-  // Issue 17: a scan stamped 2100, one without a frame id (tf2 printed ~170 lines), one of 1,000,000 beams
-  // (blocked the node for 10 s), camera detections with an Inf bearing and in a frame without tf.
+  // Malformed scans: a scan stamped 2100, one without a frame id (tf2 printed ~170 lines), one of 1,000,000
+  // beams (blocked the node for 10 s), camera detections with an Inf bearing and in a frame without tf.
   sendScan(2, "right_laser", ros::Time(4102444800.0));
   sendScan(3, "", ros::Time::now());
   sendScan(4, "right_laser", ros::Time::now(), [](sensor_msgs::LaserScan& s) { s.ranges.assign(1000000, 3.0f); });

@@ -10,7 +10,6 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <picker_localisation/GetCandidates.h>
-#include <picker_localisation/GnssBias.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/PickerBeliefArray.h>
@@ -226,27 +225,6 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
   })) << "robot_1 diagnostics never counted the bad belief";
   ASSERT_TRUE(plansAgain("robot_1")) << "robot_1 stopped planning after a bad belief";
 
-  // Bad input: a GNSS bias whose covariance is not a covariance (NaN, then asymmetric) is counted and
-  // ignored, a valid one is taken (robot_1's lane check reads it), planning goes on.
-  ros::Publisher bias_pub = nh.advertise<picker_localisation::GnssBias>("/pickers/picker_1/gnss_bias", 5);
-  ASSERT_TRUE(waitFor([&] { return bias_pub.getNumSubscribers() >= 1; }))
-      << "robot_1 (policy nbs, lane_check on) does not subscribe to /pickers/picker_1/gnss_bias";
-  picker_localisation::GnssBias bias;
-  bias.picker_id = "picker_1";
-  bias.covariance = {std::nan(""), 0.0, 0.0, 1.0};
-  bias_pub.publish(bias);
-  bias.covariance = {4.0, 1.0, -1.0, 4.0};
-  bias_pub.publish(bias);
-  bias.covariance = {4.0, 0.5, 0.5, 3.0};
-  bias_pub.publish(bias);
-  ASSERT_TRUE(waitFor([&] {
-    return diagnosticValue("robot_1", "gnss biases rejected picker_1") == "2" &&
-           diagnosticValue("robot_1", "gnss biases received picker_1") == "1";
-  })) << "robot_1 diagnostics: rejected '"
-      << diagnosticValue("robot_1", "gnss biases rejected picker_1") << "', received '"
-      << diagnosticValue("robot_1", "gnss biases received picker_1") << "'";
-  ASSERT_TRUE(plansAgain("robot_1")) << "robot_1 stopped planning after a bad GNSS bias";
-
   // Missing tf: robot_4 publishes no goal and reports the missing pose.
   std::lock_guard<std::mutex> lock(g_mutex);
   EXPECT_EQ(g_goals.count("robot_4"), 0u);
@@ -256,8 +234,9 @@ TEST(NbsPlannerNode, GoalsCandidatesMarkersAndFleet) {
       << g_diagnostics.at("robot_4").message;
 }
 
-// Issue 17: when the robot's localisation stops, tf keeps serving the last pose. robot_5 (max_pose_age 1 s)
-// plans while its pose is fresh, then stops planning and says why instead of sending the robot from where it was.
+// A stale pose: when the robot's localisation stops, tf keeps serving the last pose. robot_5 (max_pose_age 1
+// s) plans while its pose is fresh, then stops planning and says why instead of sending the robot from where
+// it was.
 TEST(NbsPlannerNode, StaleRobotPoseStopsPlanning) {
   ros::NodeHandle nh;
   ros::Subscriber goals = nh.subscribe("/robot_5/goal", 5, goalCallback);

@@ -204,9 +204,9 @@ TEST(GnssIngest, RejectsBadFixesAndKeepsGoing) {
   EXPECT_EQ(c.out_of_order, 2u);
 }
 
-// Issue 17: five 50 km glitches re-anchored the jump gate and the belief snapped 23 m to the nearest node. A fix
-// farther than max_map_distance from every node is rejected before the gate: nothing re-anchors, the next fix
-// near the last good one is accepted without a gate reset.
+// Glitches: five 50 km glitches re-anchored the jump gate and the belief snapped 23 m to the nearest node. A
+// fix farther than max_map_distance from every node is rejected before the gate: nothing re-anchors, the next
+// fix near the last good one is accepted without a gate reset.
 TEST(GnssIngest, FixesFarOffTheMapAreRejectedNotSnapped) {
   GnssFixture fx;  // lattice -20 .. 20 m
   GnssIngest gnss("picker_1", fx.map, fx.datum);
@@ -692,7 +692,7 @@ TEST(UwbRanging, BatchesAnchorsIntoOneObservationAndRejectsBadInput) {
   EXPECT_EQ(c.updates, 2u);
 }
 
-// Issue 17 soak: every tag ever ranged kept its grids (~6 MB each; 180 MB per robot with 30 pickers). A tag not
+// Soak: every tag ever ranged kept its grids (~6 MB each; 180 MB per robot with 30 pickers). A tag not
 // ranged for reset_after s is freed at the next flush; it restarts from the uniform prior, as it would have.
 TEST(UwbRanging, FiltersOfTagsOutOfRangeAreFreed) {
   auto map = latticeMap(10.0, 0.5);

@@ -200,15 +200,14 @@ TEST(TpfEquations, PredictionJumpsAtTheEq2Rate) {
   }
 }
 
-TEST(TpfEquations, JumpsDoNotDependOnThePredictionRate) {
-  // Step consistent (default): one 3 s step and thirty 0.1 s steps both leave half the particles at node 3
-  // (Eq. 2 = 1/2 at the half-edge dwell). Literal: Eq. 2 afresh at every step moves far more of them.
+TEST(TpfEquations, Eq2AppliedAfreshAtEveryPrediction) {
+  // Eq. 2 read literally: one 3 s step leaves half the particles at node 3 (Eq. 2 = 1/2 at the half-edge
+  // dwell); thirty 0.1 s steps apply Eq. 2 afresh each time and move far more of them.
   auto map = laneMap();
-  auto fraction_moved = [&](bool consistent, int steps) {
+  auto fraction_moved = [&](int steps) {
     TpfParams p = staticParams(20000);
     p.velocity_init_mean = 0.5;
     p.dwell_init_max = 0.0;
-    p.step_consistent_jumps = consistent;
     TopologicalParticleFilter f(map, p, 7);
     EXPECT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
     for (int k = 1; k <= steps; ++k) f.predictTo(3.0 * k / steps);
@@ -216,18 +215,8 @@ TEST(TpfEquations, JumpsDoNotDependOnThePredictionRate) {
     for (const auto& q : f.particles()) moved += q.node != 2 ? 1.0 : 0.0;
     return moved / 20000.0;
   };
-  EXPECT_NEAR(fraction_moved(true, 1), 0.5, 0.015);
-  EXPECT_NEAR(fraction_moved(true, 30), 0.5, 0.015);
-  EXPECT_NEAR(fraction_moved(false, 1), 0.5, 0.015);
-  EXPECT_GT(fraction_moved(false, 30), 0.8);
-  // Step consistent: a step with dt = 0 (e.g. a late observation fused at the current time) never jumps.
-  TpfParams p = staticParams(1000);
-  p.velocity_init_mean = 0.5;
-  p.step_consistent_jumps = true;
-  TopologicalParticleFilter f(map, p, 3);
-  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
-  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
-  for (const auto& q : f.particles()) EXPECT_EQ(q.node, 2u);
+  EXPECT_NEAR(fraction_moved(1), 0.5, 0.015);
+  EXPECT_GT(fraction_moved(30), 0.8);
 }
 
 // --------------------------------------------------------------------------------------------- Eq. 8 ------
@@ -254,11 +243,6 @@ TEST(TpfEquations, Eq8WeightPerSensor) {
   EXPECT_NEAR(f.particleWeight(p, 0.8, lidar), 0.2, 1e-12);
   // Unknown sensor: default gamma (0.25, 0).
   EXPECT_NEAR(f.particleWeight(p, 1.0, obsAt(0.0, {1}, {1.0}, false, "sonar")), 0.25, 1e-12);
-  // gamma as confidence: 0.25 * 0.8 + 0.75.
-  TpfParams c;
-  c.gamma_as_confidence = true;
-  TopologicalParticleFilter fc(map, c, 1);
-  EXPECT_NEAR(fc.particleWeight(p, 0.8, lidar), 0.95, 1e-12);
   // Product combination: w_q (1 + w_v); gnss, L^ = 0.5, opposite velocity: 0.5 * (1 + 0.25) = 0.625; and a
   // particle outside the likelihood's support weighs 0.
   TpfParams prod;
@@ -309,25 +293,22 @@ TEST(TpfFilter, SparseJsdMatchesDefinition) {
 
 // ------------------------------------------------------------------------------------ Eq. 1, 9, 10 ------
 TEST(TpfFilter, Eq1InitialisationFromIdentifyingLikelihood) {
-  // Weights uniform (gamma as confidence with gamma_q = 0) so the first update keeps the initial particles.
+  // Eq. 1 puts 1/4 of the particles at node 5 and 3/4 at node 40; the same update then weighs them by Eq. 8
+  // (L^ = 1/3 and 1) and resamples: 1/12 against 3/4, i.e. 0.1 and 0.9 of the particles that stayed on the
+  // two nodes (those that jumped during the dt = 0 prediction leave the likelihood's support and weigh 0).
   auto map = polytunnel();
   TpfParams p = staticParams(20000);
-  p.gamma_as_confidence = true;
-  p.sensor_gammas["rfid"] = {0.0, 0.0};
   p.velocity_init_mean = 0.1;
   p.velocity_init_variance = 0.05;
   TopologicalParticleFilter f(map, p, 11);
   ASSERT_TRUE(f.update(obsAt(0.0, {5, 40}, {1.0, 3.0}, true, "rfid")).ok());
-  // Some particles jump during the dt = 0 prediction (tau in [0, 1] s, random velocity): count each node with
-  // its neighbours.
-  ASSERT_GT(map->hopDistance(5, 40), 2);
-  double near5 = 0.0, near40 = 0.0;
+  double at5 = 0.0, at40 = 0.0;
   for (const auto& q : f.particles()) {
-    near5 += map->hopDistance(q.node, 5) <= 1 ? 1.0 : 0.0;
-    near40 += map->hopDistance(q.node, 40) <= 1 ? 1.0 : 0.0;
+    at5 += q.node == 5 ? 1.0 : 0.0;
+    at40 += q.node == 40 ? 1.0 : 0.0;
   }
-  EXPECT_NEAR(near5 / 20000.0, 0.25, 0.01);
-  EXPECT_NEAR(near40 / 20000.0, 0.75, 0.01);
+  EXPECT_EQ(at5 + at40, 20000.0);
+  EXPECT_NEAR(at5 / 20000.0, 0.1, 0.01);
   double mx = 0, my = 0, vx2 = 0, tau_min = 1e9, tau_max = -1e9;
   for (const auto& q : f.particles()) {
     mx += q.vx;
@@ -349,11 +330,13 @@ TEST(TpfFilter, Eq1InitialisationFromIdentifyingLikelihood) {
 
 TEST(TpfFilter, Eq1NonIdentifyingInitialisesUniformlyOverTheMap) {
   auto map = polytunnel();  // 144 nodes
-  TpfParams p = staticParams(map->numNodes() * 100);
-  p.gamma_as_confidence = true;
-  p.default_gamma = {0.0, 0.0};
-  TopologicalParticleFilter f(map, p, 5);
-  ASSERT_TRUE(f.update(obsAt(0.0, {3}, {1.0}, false, "lidar_unknown")).ok());
+  // An anonymous observation equally likely at every node: Eq. 1 spreads the particles uniformly and Eq. 8
+  // weighs them alike, so the uniform spread is what the update leaves.
+  TopologicalParticleFilter f(map, staticParams(map->numNodes() * 100), 5);
+  std::vector<NodeIndex> every(map->numNodes());
+  for (std::size_t i = 0; i < every.size(); ++i) every[i] = static_cast<NodeIndex>(i);
+  ASSERT_TRUE(
+      f.update(obsAt(0.0, every, std::vector<double>(every.size(), 1.0), false, "lidar_unknown")).ok());
   auto frac = nodeFractions(f.particles());
   EXPECT_EQ(frac.size(), map->numNodes());
   for (const auto& [n, v] : frac) EXPECT_NEAR(v * 100.0 * map->numNodes(), 100.0, 45.0) << n;  // > 4 sigma
@@ -896,16 +879,11 @@ TEST(TpfTracking, SyntheticLaneWithExactGnssWithinOneHop) {
   up.push_back(*map->index("H4"));
   for (int j = 0; j < 10; ++j) up.push_back(*map->index("r4_" + std::to_string(j)));
   up.push_back(*map->index("T4"));
-  for (bool consistent : {false, true}) {
-    for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
-      TpfParams p = paperTpf();
-      p.step_consistent_jumps = consistent;
-      TopologicalParticleFilter f(map, p, seed);
-      const TrackStats s = trackWalk(f, up, 0.5, 5.0);
-      EXPECT_LE(s.max_hops, 1) << "seed " << seed << " at t = " << s.worst_time << " s, consistent "
-                               << consistent;
-      EXPECT_LE(map->hopDistance(f.belief().map_node, *map->index("T4")), 1);
-    }
+  for (std::uint64_t seed : {1u, 2u, 3u, 4u, 5u}) {
+    TopologicalParticleFilter f(map, paperTpf(), seed);
+    const TrackStats s = trackWalk(f, up, 0.5, 5.0);
+    EXPECT_LE(s.max_hops, 1) << "seed " << seed << " at t = " << s.worst_time << " s";
+    EXPECT_LE(map->hopDistance(f.belief().map_node, *map->index("T4")), 1);
   }
   // Up and back down (a reversal at the far end): the particles must turn (dead end); at most two hops
   // while they do, within one hop at >= 95 % of the steps.

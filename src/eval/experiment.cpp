@@ -299,7 +299,7 @@ class GraphRun {
   // claims.
   void positionIdleRobots(double now);
   // The planner's views of the pickers, with the bias covariance gnss_ingest publishes at `now`.
-  std::vector<nbs::BeliefSource*> views(double now);
+  std::vector<nbs::BeliefSource*> views();
   // The planner of config/nbs.yaml (planning_period, battery_level, what_if_seed as the node reads them) with
   // `policy`, and a what-if view of every picker's filter.
   void makePlanner(nbs::Policy policy);
@@ -627,18 +627,14 @@ void GraphRun::endOfStep(double now) {
     return;
   }
   if (!planner_ || !(simulator_.robot(0).atGoal() || now - last_plan_ >= replan_period_)) return;
-  const nbs::PlanResult plan = planner_->plan(simulator_.robot(0).currentNode(), battery_level_, views(now));
+  const nbs::PlanResult plan = planner_->plan(simulator_.robot(0).currentNode(), battery_level_, views());
   if (plan.ok()) simulator_.setRobotGoal(0, plan.ranked.front().node);
   last_plan_ = now;
 }
 
-std::vector<nbs::BeliefSource*> GraphRun::views(double now) {
+std::vector<nbs::BeliefSource*> GraphRun::views() {
   std::vector<nbs::BeliefSource*> out;
-  for (std::size_t i = 0; i < sources_.size(); ++i) {
-    // The bias covariance gnss_ingest publishes (GnssBias.covariance), as the nbs_planner node reads it.
-    sources_[i]->setBiasCovariance(gnss_->find(scoring_[i].id)->ingest.bias().appliedCovariance(now));
-    out.push_back(sources_[i].get());
-  }
+  for (auto& source : sources_) out.push_back(source.get());
   return out;
 }
 
@@ -664,7 +660,7 @@ void GraphRun::positionIdleRobots(double now) {
       goals.push_back(idle_[r].goal);
     }
   }
-  const std::vector<nbs::BeliefSource*> pickers = views(now);
+  const std::vector<nbs::BeliefSource*> pickers = views();
   for (std::size_t r : due) {
     const std::string& id = simulator_.robot(r).id();
     const nbs::PlanResult plan =

@@ -27,51 +27,6 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNegligibleMass = 1e-9;  // belief mass in a read region below this gives no gain
 
-// t_k of LaneCheckModel: the node masses blurred by a 2D Gaussian of covariance `cov` (the bias covariance).
-// Each node's mass is spread over the nodes within 3 sigma of it, in proportion to the Gaussian density and
-// normalised per source node (so no mass is lost). A covariance below 1 cm std leaves the masses as they are.
-NodeMasses blurredByBias(const TopologicalMap& map, const NodeMasses& masses, const Eigen::Matrix2d& cov) {
-  constexpr double kMinVariance = 1e-4;  // m^2 (1 cm std): nothing to blur
-  constexpr double kRegulariser = 1e-2;  // m^2 added to invert a degenerate covariance (10 cm std)
-  if (!cov.allFinite()) return masses;
-  const Eigen::Matrix2d sym = 0.5 * (cov + cov.transpose());
-  const double half_trace = 0.5 * (sym(0, 0) + sym(1, 1));  // largest eigenvalue of a symmetric 2x2:
-  const double largest = half_trace + std::hypot(0.5 * (sym(0, 0) - sym(1, 1)), sym(0, 1));
-  if (!(largest > kMinVariance)) return masses;
-  const Eigen::Matrix2d information = (sym + kRegulariser * Eigen::Matrix2d::Identity()).inverse();
-  const double radius = 3.0 * std::sqrt(largest + kRegulariser);
-  NodeMasses out(masses.size(), 0.0);
-  std::vector<double> w;
-  for (std::size_t n = 0; n < masses.size(); ++n) {
-    if (!(masses[n] > kNegligibleMass)) continue;
-    const Eigen::Vector2d centre = map.position2d(static_cast<NodeIndex>(n));
-    const std::vector<NodeIndex> near = map.nodesWithin(centre, radius);
-    w.assign(near.size(), 0.0);
-    double z = 0.0;
-    for (std::size_t i = 0; i < near.size(); ++i) {
-      const Eigen::Vector2d d = map.position2d(near[i]) - centre;
-      w[i] = std::exp(-0.5 * d.dot(information * d));
-      z += w[i];
-    }
-    if (!(z > 0.0)) {
-      out[n] += masses[n];
-      continue;
-    }
-    for (std::size_t i = 0; i < near.size(); ++i) out[near[i]] += masses[n] * w[i] / z;
-  }
-  return out;
-}
-
-// Entropy (nats) of the lane masses of `masses`; the nodes outside every lane form one more class.
-double laneEntropy(const TopologicalMap& map, const NodeMasses& masses) {
-  std::vector<double> lanes(map.numLanes() + 1, 0.0);
-  for (std::size_t n = 0; n < masses.size(); ++n) {
-    const topology::LaneIndex l = map.lane(static_cast<NodeIndex>(n));
-    lanes[l == topology::kNoLane ? map.numLanes() : static_cast<std::size_t>(l)] += masses[n];
-  }
-  return entropy(lanes);
-}
-
 std::vector<std::string> splitNatural(const std::string& s) {
   std::vector<std::string> parts;
   std::size_t i = 0;
@@ -170,14 +125,6 @@ std::string PlannerConfig::validate() const {
   if (!(rfid.p_detect > 0.0 && rfid.p_detect < 1.0)) return "rfid/p_detect must be in (0, 1)";
   if (!(rfid.min_sensing_time >= 0.0)) return "rfid/min_sensing_time must be >= 0";
   if (!positive(rfid.max_sensing_time)) return "rfid/max_sensing_time must be > 0";
-  if (!(lidar.view_range >= 0.0) || !std::isfinite(lidar.view_range)) return "lidar/view_range must be >= 0";
-  if (!(lidar.p_detect >= 0.0 && lidar.p_detect < 1.0)) return "lidar/p_detect must be in [0, 1)";
-  if (!(lane_check.weight >= 0.0) || !std::isfinite(lane_check.weight))
-    return "lane_check/weight must be >= 0";
-  if (!positive(lane_check.view_range)) return "lane_check/view_range must be > 0";
-  if (!(lane_check.p_detect >= 0.0 && lane_check.p_detect <= 1.0))
-    return "lane_check/p_detect must be in [0, 1]";
-  if (!positive(lane_check.sighting_std)) return "lane_check/sighting_std must be > 0";
   if (!positive(energy.capacity)) return "energy/capacity must be > 0";
   if (!positive(energy.speed)) return "energy/speed must be > 0";
   if (!(energy.drive_energy_per_m >= 0.0 && energy.base_power >= 0.0 && energy.sensing_power >= 0.0))
@@ -194,7 +141,7 @@ const std::vector<std::string>& PlannerConfig::yamlKeys() {
   // clang-format off
   static const std::vector<std::string> keys = {
       "policy", "weights", "interactions", "horizon_hops", "horizon_m", "horizon_bucket", "planning_latency", "rfid",
-      "lidar", "lane_check", "energy", "claimed_picker_weight", "claim_exclusion_hops", "target_picker"};
+      "energy", "claimed_picker_weight", "claim_exclusion_hops", "target_picker"};
   // clang-format on
   return keys;
 }
@@ -219,8 +166,6 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::s
     const std::vector<std::pair<const char*, std::vector<std::string>>> sections = {
         {"weights", criterionNames()},
         {"rfid", {"read_range", "p_detect", "min_sensing_time", "max_sensing_time"}},
-        {"lidar", {"view_range", "p_detect"}},
-        {"lane_check", {"weight", "view_range", "p_detect", "sighting_std"}},
         {"energy", {"capacity", "drive_energy_per_m", "base_power", "sensing_power", "speed", "reserve"}}};
     for (const auto& [section, keys] : sections)
       if (node[section])
@@ -260,16 +205,6 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::s
     readKey(r, "p_detect", c.rfid.p_detect, "rfid/");
     readKey(r, "min_sensing_time", c.rfid.min_sensing_time, "rfid/");
     readKey(r, "max_sensing_time", c.rfid.max_sensing_time, "rfid/");
-  }
-  if (const YAML::Node l = node["lidar"]) {
-    readKey(l, "view_range", c.lidar.view_range, "lidar/");
-    readKey(l, "p_detect", c.lidar.p_detect, "lidar/");
-  }
-  if (const YAML::Node l = node["lane_check"]) {
-    readKey(l, "weight", c.lane_check.weight, "lane_check/");
-    readKey(l, "view_range", c.lane_check.view_range, "lane_check/");
-    readKey(l, "p_detect", c.lane_check.p_detect, "lane_check/");
-    readKey(l, "sighting_std", c.lane_check.sighting_std, "lane_check/");
   }
   if (const YAML::Node e = node["energy"]) {
     readKey(e, "capacity", c.energy.capacity, "energy/");
@@ -343,6 +278,36 @@ PlanResult NextBestSensePlanner::plan(NodeIndex robot_node, double battery_level
              : planNextBestSense(robot_node, battery_level, pickers, claims);
 }
 
+// One picker's expected entropy reduction by a sensing stop at c (the rfid_gain criterion, Polvara et al.
+// 2021 Sec. V): H(b) - P(read) H(b | read) - P(no read) H(b | no read), with the observations rfid_ranging
+// would report (identifying; read: L(n) = 1 in the read region, no read: 1 - p_detect there and 1
+// elsewhere) and P(read) = p_detect b(region). Clamped at 0: it is >= 0 in expectation, particle noise can
+// dip below.
+double NextBestSensePlanner::expectedRfidGain(BeliefSource& source, NodeIndex c,
+                                              const std::vector<NodeIndex>& region, const NodeMasses& prior,
+                                              double horizon, std::size_t* what_if_queries) const {
+  const std::size_t n = map_->numNodes();
+  const double p_detect = config_.rfid.p_detect;
+  double in_region = 0.0;
+  for (NodeIndex m : region) in_region += prior[m];
+  const double p_read = std::clamp(p_detect * in_region, 0.0, 1.0);
+  core::Observation read;
+  read.sensor = "rfid";
+  read.picker_id = source.pickerId();
+  read.identifying = true;
+  read.position = map_->position2d(c);
+  core::Observation no_read = read;
+  read.nodes = region;
+  read.likelihood.assign(region.size(), 1.0);
+  core::setLikelihoodOverEveryNode(no_read, n);
+  for (NodeIndex m : region) no_read.likelihood[m] = 1.0 - p_detect;
+  const NodeMasses post_read = source.posterior(horizon, read);
+  const NodeMasses post_none = source.posterior(horizon, no_read);
+  if (what_if_queries) *what_if_queries += 2;
+  if (post_read.size() != n || post_none.size() != n) return 0.0;
+  return std::max(0.0, entropy(prior) - p_read * entropy(post_read) - (1.0 - p_read) * entropy(post_none));
+}
+
 PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double battery,
                                                    const std::vector<BeliefSource*>& pickers,
                                                    const std::vector<Claim>& claims) const {
@@ -369,11 +334,6 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     BeliefSource* source = nullptr;
     double weight = 1.0;
     std::map<long, NodeMasses> predicted;  // horizon bucket -> predicted masses
-    struct LaneView {
-      NodeMasses where;  // t_k: predicted masses blurred by the bias covariance
-      double lane_gain;  // H_lane(t_k) - H_lane(t'_k), nats
-    };
-    std::map<long, LaneView> lane_view;  // horizon bucket -> lane check inputs
   };
   std::vector<PickerState> states;
   for (BeliefSource* s : pickers) {
@@ -392,26 +352,7 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     const double travel_time = dist[c] / config_.energy.speed + config_.planning_latency;
     const long bucket = std::lround(travel_time / config_.horizon_bucket);
     const double horizon = static_cast<double>(bucket) * config_.horizon_bucket;
-    // Sensing region: the RFID read disc and the LiDAR view along c's lane; p_miss(n) = P(not read, not seen).
-    std::vector<NodeIndex> region = map_->nodesWithin(map_->position2d(c), rfid.read_range);
-    std::map<NodeIndex, double> p_miss;
-    for (NodeIndex m : region) p_miss[m] = 1.0 - rfid.p_detect;
-    const topology::LaneIndex lane = map_->lane(c);
-    if (config_.lidar.view_range > 0.0 && config_.lidar.p_detect > 0.0 && lane != topology::kNoLane)
-      for (NodeIndex m : map_->nodesWithin(map_->position2d(c), config_.lidar.view_range))
-        if (map_->lane(m) == lane) {
-          auto it = p_miss.emplace(m, 1.0).first;
-          it->second *= 1.0 - config_.lidar.p_detect;
-        }
-    region.clear();
-    for (const auto& kv : p_miss) region.push_back(kv.first);
-    // Lane check view: the nodes of c's lane within lane_check/view_range of c.
-    std::vector<NodeIndex> lane_view;
-    const LaneCheckModel& check = config_.lane_check;
-    if (check.weight > 0.0 && check.p_detect > 0.0 && lane != topology::kNoLane)
-      for (NodeIndex m : map_->nodesWithin(map_->position2d(c), check.view_range))
-        if (map_->lane(m) == lane) lane_view.push_back(m);
-
+    const std::vector<NodeIndex> region = map_->nodesWithin(map_->position2d(c), rfid.read_range);
     double gain = 0.0, best_gain = 0.0, p_none_in_range = 1.0;
     std::string best_picker;
     for (PickerState& p : states) {
@@ -419,55 +360,13 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
       if (it == p.predicted.end()) it = p.predicted.emplace(bucket, p.source->predicted(horizon)).first;
       const NodeMasses& prior = it->second;
       if (prior.size() != n) continue;  // no belief for this picker yet
-      double picker_gain = 0.0;         // this picker's share of the criterion, weighted
-      if (!lane_view.empty() && p.weight > 0.0) {
-        auto lv = p.lane_view.find(bucket);
-        if (lv == p.lane_view.end()) {
-          // After a sighting the bias covariance is the Kalman posterior with R = sighting_std^2 I:
-          // S' = S - S (S + R)^-1 S.
-          const Eigen::Matrix2d bias = p.source->biasCovariance();
-          const Eigen::Matrix2d r = check.sighting_std * check.sighting_std * Eigen::Matrix2d::Identity();
-          const Eigen::Matrix2d after = bias - bias * (bias + r).inverse() * bias;
-          NodeMasses where = blurredByBias(*map_, prior, bias);
-          const double h = std::max(
-              0.0, laneEntropy(*map_, where) - laneEntropy(*map_, blurredByBias(*map_, prior, after)));
-          lv = p.lane_view.emplace(bucket, PickerState::LaneView{std::move(where), h}).first;
-        }
-        double in_view = 0.0;
-        for (NodeIndex m : lane_view) in_view += lv->second.where[m];
-        picker_gain +=
-            p.weight * check.weight * check.p_detect * std::min(in_view, 1.0) * lv->second.lane_gain;
-      }
-      double in_region = 0.0, p_read = 0.0;
-      for (NodeIndex m : region) {
-        in_region += prior[m];
-        p_read += prior[m] * (1.0 - p_miss[m]);
-      }
+      double in_region = 0.0;
+      for (NodeIndex m : region) in_region += prior[m];
       in_region = std::clamp(in_region, 0.0, 1.0);
-      p_read = std::clamp(p_read, 0.0, 1.0);
       p_none_in_range *= 1.0 - in_region;
-      if (in_region >= kNegligibleMass && p.weight > 0.0) {
-        // Hypothetical RFID outcomes as rfid_ranging would report them (identifying, gamma_RFID = 1).
-        core::Observation read;
-        read.sensor = "rfid";
-        read.picker_id = p.source->pickerId();
-        read.identifying = true;
-        read.position = map_->position2d(c);
-        core::Observation no_read = read;
-        read.nodes = region;
-        read.likelihood.clear();
-        // p(seen | n), scaled so that a node seen by RFID alone has 1 (RFID only: the paper's L(n) = 1).
-        for (NodeIndex m : region) read.likelihood.push_back((1.0 - p_miss[m]) / rfid.p_detect);
-        core::setLikelihoodOverEveryNode(no_read, n);
-        for (NodeIndex m : region) no_read.likelihood[m] = p_miss[m];
-        const NodeMasses post_read = p.source->posterior(horizon, read);
-        const NodeMasses post_none = p.source->posterior(horizon, no_read);
-        result.what_if_queries += 2;
-        // Expected information gain; clamped at 0 (it is >= 0 in expectation, particle noise can dip below).
-        if (post_read.size() == n && post_none.size() == n)
-          picker_gain += p.weight * std::max(0.0, entropy(prior) - p_read * entropy(post_read) -
-                                                      (1.0 - p_read) * entropy(post_none));
-      }
+      if (in_region < kNegligibleMass || !(p.weight > 0.0)) continue;
+      const double picker_gain =
+          p.weight * expectedRfidGain(*p.source, c, region, prior, horizon, &result.what_if_queries);
       gain += picker_gain;
       if (picker_gain > best_gain) {
         best_gain = picker_gain;

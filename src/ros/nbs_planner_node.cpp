@@ -164,12 +164,6 @@ void NbsPlannerNode::applyPickerList(const std::vector<std::string>& ids) {
     in->id = id;
     if (use_what_if_ && planner_->config().policy == nbs::Policy::kNextBestSense)
       in->what_if = nh_.serviceClient<picker_localisation::WhatIf>("/pickers/" + id + "/what_if", true);
-    if (planner_->config().policy == nbs::Policy::kNextBestSense &&
-        planner_->config().lane_check.weight > 0.0)
-      in->bias_sub = nh_.subscribe<picker_localisation::GnssBias>(
-          "/pickers/" + id + "/gnss_bias", 5,
-          boost::function<void(const picker_localisation::GnssBias::ConstPtr&)>(
-              [this, id](const picker_localisation::GnssBias::ConstPtr& msg) { biasCallback(id, msg); }));
     next.push_back(std::move(in));
   }
   pickers_ = std::move(next);
@@ -202,25 +196,6 @@ void NbsPlannerNode::beliefCallback(const picker_localisation::PickerBelief& msg
   if (rejected > 0) ++in.rejected;
   ++in.received;
   in.belief = msg;
-}
-
-void NbsPlannerNode::biasCallback(const std::string& picker_id,
-                                  const picker_localisation::GnssBias::ConstPtr& msg) {
-  const auto found = by_id_.find(picker_id);
-  if (found == by_id_.end()) return;  // the picker left the list
-  PickerInput& in = *found->second;
-  const auto& c = msg->covariance;
-  const Eigen::Matrix2d cov = (Eigen::Matrix2d() << c[0], c[1], c[2], c[3]).finished();
-  if (!core::isCovariance2d(cov) || (!msg->picker_id.empty() && msg->picker_id != picker_id)) {
-    ++in.bias_rejected;
-    ROS_WARN_THROTTLE(10.0,
-                      "%s: rejected a GNSS bias of %s (picker id '%s', covariance not a finite symmetric "
-                      "positive semi-definite 2x2); keeping the last",
-                      ros::this_node::getName().c_str(), picker_id.c_str(), msg->picker_id.c_str());
-    return;
-  }
-  ++in.bias_received;
-  in.bias_covariance = cov;
 }
 
 void NbsPlannerNode::peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg) {
@@ -338,7 +313,6 @@ void NbsPlannerNode::planOnce() {
     }
     sources.push_back(std::make_unique<WhatIfBeliefSource>(
         in->id, map_, *in->belief, client, static_cast<std::uint32_t>(what_if_seed_), map_frame_));
-    if (in->bias_covariance) sources.back()->setBiasCovariance(*in->bias_covariance);
     pointers.push_back(sources.back().get());
   }
   std::vector<nbs::Claim> goals;
@@ -483,10 +457,6 @@ void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
     if (in->belief) ++with_belief;
     stat.add("beliefs received " + in->id, in->received);
     stat.add("beliefs rejected " + in->id, in->rejected);
-    if (in->bias_sub) {
-      stat.add("gnss biases received " + in->id, in->bias_received);
-      stat.add("gnss biases rejected " + in->id, in->bias_rejected);
-    }
   }
   stat.add("robot id", robot_id_);
   stat.add("policy", nbs::toString(planner_->config().policy));

@@ -416,7 +416,6 @@ double TopologicalParticleFilter::particleWeight(const Particle& p, double norma
                                                  const core::Observation& obs) const {
   const SensorGamma gamma = params_.gammaFor(obs.sensor);
   double w = gamma.node * normalised_likelihood;
-  if (params_.gamma_as_confidence) w += 1.0 - gamma.node;
   if (obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity) {
     const double vs = obs.velocity->norm();
     const double sigma = std::max(0.5 * vs, params_.min_velocity_sigma);
@@ -589,7 +588,6 @@ void TopologicalParticleFilter::predict(double dt) {
   const double inv_window = 1.0 / params_.velocity_window;
   std::vector<double>& count = node_scratch_b_;
   touched_.clear();
-  const bool consistent = params_.step_consistent_jumps;
   if (params_.motion_model == MotionModel::kFixedLambda) {
     for (std::size_t i = 0; i < particles_.size(); ++i) {
       Particle& p = particles_[i];
@@ -598,9 +596,9 @@ void TopologicalParticleFilter::predict(double dt) {
       const std::uint64_t bits = rng_();
       spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
       const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32;
-      // Exponential dwell: conditional on not having jumped yet, 1 - exp(-lambda dt) (step consistent), or
-      // the cumulative 1 - exp(-lambda tau) at every step (literal).
-      const double r = 1.0 - std::exp(-params_.fixed_lambda * (consistent ? dt : tau));
+      // Exponential dwell (Khan et al. 2020): the cumulative 1 - exp(-lambda tau) at every step, Eq. 2 read
+      // literally.
+      const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
       if (begin == end || !(u < r)) {
         p.dwell = static_cast<float>(tau);
       } else {
@@ -637,14 +635,13 @@ void TopologicalParticleFilter::predict(double dt) {
   const double keep = params_.lane_change_keep_side;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
-    const double tau0 = static_cast<double>(p.dwell), tau = tau0 + dt;
+    const double tau = static_cast<double>(p.dwell) + dt;
     const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
     const double vx = p.vx, vy = p.vy;
     const std::uint64_t bits = rng_();
     spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
-    // Per arc: b (Eq. 2), survival e1 = exp(lambda tau) at the dwell reached and e0 = exp(lambda tau0) at the
-    // last step (1 in literal mode). Jump to k in this step with probability b_k (e0_k - e1_k) / sum b e0:
-    // literal mode = Eq. 2 / 3 at tau; step-consistent mode = the same conditioned on no earlier jump.
+    // Per arc: b (Eq. 2) and the survival e1 = exp(lambda tau) at the dwell reached. Jump to k in this step
+    // with probability b_k (1 - e1_k) / sum b: Eqs. 2-3 at tau, read literally.
     // Turning: when no edge lies within acos(turn_fraction) of the velocity (lane end, corner into the
     // headland), every edge gets b = |v| (see turn_projection_fraction).
     // On a lane-change path: the path's next node gets b = |v|, every other edge lane_change_leak |v|.
@@ -679,16 +676,15 @@ void TopologicalParticleFilter::predict(double dt) {
           if (proj[e - begin] > 0.0)
             proj[e - begin] *= g.exitWeight(p.node, g.arcs[e].target, p.last_lane_change, keep);
     }
-    double sum_b = 0.0, sum_c = 0.0, denom = 0.0;
+    double sum_b = 0.0, sum_c = 0.0;
     for (std::uint32_t e = begin; e < end; ++e) {
       const auto& arc = g.arcs[e];
       const double b = proj[e - begin];
-      double c = 0.0, e0 = 1.0;
+      double c = 0.0;
       if (b > 0.0) {
         // exp(lambda tau), lambda of Eq. 6; single precision is ample for a probability and twice as fast.
         const double e1 = std::exp(static_cast<float>(arc.rate * b * tau));
-        if (consistent && tau0 > 0.0) e0 = std::exp(static_cast<float>(arc.rate * b * tau0));
-        c = b * (e0 - e1);
+        c = b * (1.0 - e1);
         proj[e - begin] = b * (1.0 - e1);  // b is no longer needed: keep Eq. 2-3's term for Eq. 7
       } else {
         proj[e - begin] = 0.0;
@@ -696,10 +692,8 @@ void TopologicalParticleFilter::predict(double dt) {
       contrib[e - begin] = c;
       sum_b += b;
       sum_c += c;
-      denom += b * e0;
     }
-    if (!(denom > 1e-300)) denom = sum_b;  // survival underflowed: the particle is overdue, use Eq. 2 as is
-    const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32 * denom;  // jump w.p. sum_c / denom
+    const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32 * sum_b;  // jump w.p. sum_c / sum_b
     if (!(u < sum_c)) {
       p.dwell = static_cast<float>(tau);
     } else {
@@ -809,14 +803,13 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   const SensorGamma gamma = params_.gammaFor(obs.sensor);
   const bool velocity_term =
       obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity;
-  const double base = params_.gamma_as_confidence ? 1.0 - gamma.node : 0.0;
   const double gq = gamma.node * inv_max;
   // Node term of Eq. 8: gamma_q L^(q), or with the GNSS bias state gamma_q times the fix's predictive density
   // given the particle's own bias (scaled to max 1).
   const bool bias_state = params_.usesBiasState(obs.sensor) && obs.position && obs.bias_removed;
   if (bias_state) weighWithBiasState(obs);
   auto node_term = [&](std::size_t i, NodeIndex n) {
-    return (bias_state ? gamma.node * weights_[i] : gq * node_scratch_a_[n]) + base;
+    return (bias_state ? gamma.node * weights_[i] : gq * node_scratch_a_[n]);
   };
   std::vector<double>& mass = node_scratch_b_;
   touched_.clear();

@@ -79,10 +79,9 @@ std::string TpfParams::validate() const {
   if (!(min_velocity_sigma > 0.0) || !std::isfinite(min_velocity_sigma))
     return core::badValue("min_velocity_sigma", min_velocity_sigma, "> 0");
   for (const auto& [name, g] : sensor_gammas)
-    if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity) || (gamma_as_confidence && g.node > 1.0))
-      return "sensor_gammas." + name + " must be finite and >= 0 (node <= 1 with gamma_as_confidence)";
-  if (!finite_nonneg(default_gamma.node) || !finite_nonneg(default_gamma.velocity) ||
-      (gamma_as_confidence && default_gamma.node > 1.0))
+    if (!finite_nonneg(g.node) || !finite_nonneg(g.velocity))
+      return "sensor_gammas." + name + " must be finite and >= 0";
+  if (!finite_nonneg(default_gamma.node) || !finite_nonneg(default_gamma.velocity))
     return "default_gamma must be finite and >= 0";
   if (!(jsd_threshold >= 0.0 && jsd_threshold <= 1.0))
     return core::badValue("jsd_threshold", jsd_threshold, "in [0, 1]");
@@ -165,9 +164,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "velocity_window",
                                                 "min_jump_dwell",
                                                 "directed_motion",
-                                                "step_consistent_jumps",
                                                 "turn_projection_fraction",
-                                                "gamma_as_confidence",
                                                 "min_velocity_sigma",
                                                 "velocity_weight_product",
                                                 "velocity_follows_edge",
@@ -231,7 +228,6 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "velocity_window", p.velocity_window);
   read(node, "min_jump_dwell", p.min_jump_dwell);
   read(node, "directed_motion", p.directed_motion);
-  read(node, "step_consistent_jumps", p.step_consistent_jumps);
   read(node, "turn_projection_fraction", p.turn_projection_fraction);
   if (const YAML::Node g = node["sensor_gammas"]) {
     if (!g.IsMap()) throw std::runtime_error("tpf params: 'sensor_gammas' must be a map");
@@ -241,7 +237,6 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
     }
   }
   if (const YAML::Node g = node["default_gamma"]) p.default_gamma = readGamma(g, "default_gamma");
-  read(node, "gamma_as_confidence", p.gamma_as_confidence);
   read(node, "min_velocity_sigma", p.min_velocity_sigma);
   read(node, "velocity_weight_product", p.velocity_weight_product);
   read(node, "velocity_follows_edge", p.velocity_follows_edge);

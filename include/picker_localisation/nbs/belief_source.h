@@ -32,16 +32,6 @@ class BeliefSource {
   // Node masses after predicting `horizon` s and fusing the hypothetical observation `obs`; the live belief
   // is untouched. Empty when not available.
   virtual NodeMasses posterior(double horizon, const core::Observation& obs) = 0;
-
-  // Covariance (m^2, map frame) of the picker's GNSS bias estimate (GnssBias.covariance from gnss_ingest: the
-  // prior before the first sighting, growing with the age of the last one). Every fix carries the same bias,
-  // so the belief can sit confidently one lane off while the truth is anywhere within this covariance of it:
-  // the planner's lane check (PlannerConfig::lane_check) needs it. Zero (the default) when unknown.
-  void setBiasCovariance(const Eigen::Matrix2d& covariance) { bias_covariance_ = covariance; }
-  const Eigen::Matrix2d& biasCovariance() const { return bias_covariance_; }
-
- private:
-  Eigen::Matrix2d bias_covariance_ = Eigen::Matrix2d::Zero();
 };
 
 // A belief that does not move (predicted(h) is the belief for every h) and fuses an observation by Bayes'

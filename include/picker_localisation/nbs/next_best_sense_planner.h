@@ -10,8 +10,8 @@
 //                               the window with probability p_detect); with q(c) = P(at least one picker
 //                               within read_range of c) under the predicted beliefs, ST = min_sensing_time +
 //                               q (1 - e^{-r T}) / r + (1 - q) T,  T = max_sensing_time.
-//  rfid_gain [nats], benefit:   expected entropy reduction of the pickers' beliefs by the sensing operation
-//                               (RFID reads and, with lidar/view_range > 0, the same-lane LiDAR view):
+//  rfid_gain [nats], benefit:   expected entropy reduction of the pickers' beliefs by the RFID sensing
+//                               operation:
 //                               sum_k w_k [H(b_k) - P_k(read) H(b_k | read) - P_k(no read) H(b_k | no read)],
 //                               b_k the belief of picker k predicted to the arrival time (travel time
 //                               = travel_distance / speed), the posteriors from the BeliefSource what-if with
@@ -19,9 +19,7 @@
 //                               read_range of c, no read L(n) = 1 - p_detect within read_range and 1
 //                               elsewhere; P_k(read) = p_detect * b_k(read region). w_k = 1, or
 //                               claimed_picker_weight when another robot of higher priority already serves
-//                               picker k. Plus the lane check (lane_check/weight > 0, issue "Find the
-//                               lane"): sum_k w_k weight P_k(seen at c) (H_lane(t_k) - H_lane(t'_k)), see
-//                               LaneCheckModel.
+//                               picker k.
 //  battery [fraction], benefit: expected battery level after driving to c and sensing there (EnergyModel).
 // Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m
 // metres, minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them),
@@ -68,40 +66,6 @@ struct RfidSensingModel {
   double expectedSensingTime(double q) const;
 };
 
-// The LiDAR view the planner expects at a candidate (issue "Find the lane"): a stop in a lane sees the people in
-// that lane within view_range (the beds hide the neighbouring lanes at leg height), and a person seen there is
-// associated with its picker and corrects its GNSS bias, which names the lane. Folded into the sensing
-// outcome of the rfid_gain criterion: "seen" means read or seen, p(seen | n) = 1 - (1 - p_rfid [n in read
-// disc]) (1 - p_detect [n in the view]). view_range 0 = RFID only (the paper's criterion).
-struct LidarSensingModel {
-  double view_range = 0.0;  // m along the candidate's lane (e.g. 8: leg_detector max_leg_range); 0 = off, as
-                            // measured best (docs/readme/nbs.md)
-  double p_detect = 0.6;    // probability that a picker in view is seen and identified during the stop
-};
-
-// The lane check (issue "Find the lane"): what a stop at c would tell us about the *lane* of each picker by a
-// same-lane LiDAR sighting, which corrects the picker's GNSS bias. The entropy of the belief cannot value it:
-// a belief built from biased fixes sits confidently, and wrongly, in one lane. So the belief b_k is first
-// blurred by the bias covariance S_k (BeliefSource::biasCovariance): t_k(m) = sum_n b_k(n) N(x_m - x_n; 0,
-// S_k) / Z_n (Z_n normalises over the nodes within 3 sigma of n), where the picker truly is if the whole
-// belief may be off by the bias. H_lane(t) is the entropy of t's lane masses (nodes outside every lane form
-// one more class): large for a picker never sighted or sighted long ago, or whose belief is split between
-// lanes. A sighting leaves the bias with the Kalman posterior S'_k = S_k - S_k (S_k + R)^-1 S_k, R =
-// sighting_std^2 I, and t'_k the belief blurred by it. The expected gain of a stop at c is the expected lane
-// entropy removed:
-//   P_k(seen at c) max(0, H_lane(t_k) - H_lane(t'_k)),  P_k(seen at c) = p_detect t_k(nodes of c's lane
-//   within view_range of c),
-// in nats, added (times weight and w_k) to the rfid_gain criterion: ~0 for a picker sighted a moment ago (so
-// a fresh picker does not pull the robot into a neighbouring lane). A miss is counted as no information (the
-// leg tracker reports no negative evidence). Candidates outside every lane see nobody.
-struct LaneCheckModel {
-  double weight = 0.0;  // multiplies the lane gain in rfid_gain; 0 = off (the paper's criterion), as measured
-                        // (docs/readme/nbs.md "Lane check": no gain on navigation or three pickers)
-  double view_range = 8.0;  // m along the candidate's lane within which a picker is seen (leg_detector range)
-  double p_detect = 0.6;    // probability that a picker in view is seen and associated during the stop
-  double sighting_std = 0.5;  // m per axis, error of one sighting as a bias measurement (gnss_ingest's R)
-};
-
 // Energy of driving and sensing (a Thorvald-size robot on a 48 V pack; see docs/readme/nbs.md):
 //   E = drive_energy_per_m * d + base_power * (d / speed + t_sense) + sensing_power * t_sense   [J]
 //   battery after = level - E / capacity.
@@ -129,8 +93,6 @@ struct PlannerConfig {
   double horizon_bucket = 2.0;    // s, arrival times are rounded to this step to share predictions
   double planning_latency = 0.0;  // s added to every arrival time (belief age at planning)
   RfidSensingModel rfid;
-  LidarSensingModel lidar;
-  LaneCheckModel lane_check;
   EnergyModel energy;
   double claimed_picker_weight = 0.0;  // w_k of a picker served by a higher-priority robot
   int claim_exclusion_hops = 0;        // nodes within this many hops of a claimed goal are excluded too
@@ -141,7 +103,7 @@ struct PlannerConfig {
 
   // Keys as config/nbs.yaml (missing keys keep the defaults). Throws std::runtime_error naming the key. With
   // `unknown`, one message per key that is neither the planner's (yamlKeys(), and the sub-keys of weights,
-  // rfid, lidar, lane_check, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest
+  // rfid, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest
   // known key.
   static PlannerConfig fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static PlannerConfig fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
@@ -196,6 +158,9 @@ class NextBestSensePlanner {
   PlanResult planEstimatedNode(topology::NodeIndex robot, double battery,
                                const std::vector<BeliefSource*>& pickers,
                                const std::vector<Claim>& claims) const;
+  double expectedRfidGain(BeliefSource& source, topology::NodeIndex c,
+                          const std::vector<topology::NodeIndex>& region, const NodeMasses& prior,
+                          double horizon, std::size_t* what_if_queries) const;
   std::vector<topology::NodeIndex> candidateNodes(topology::NodeIndex robot,
                                                   const std::vector<Claim>& claims) const;
 

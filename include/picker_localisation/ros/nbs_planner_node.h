@@ -6,11 +6,9 @@
 // <robot_id>/base_link). Every ~planning_period s of ROS time it plans (NextBestSensePlanner, policy nbs or
 // estimated_node) and publishes the goal on goal (GoalNode, latched) and the candidates' utilities on
 // nbs_candidates (MarkerArray); service get_candidates returns the ranked candidates. Predictions and
-// hypothetical posteriors come from the trackers' /pickers/<id>/what_if services; the lane check
-// (lane_check/weight > 0, policy nbs) reads each picker's GNSS bias covariance from /pickers/<id>/gnss_bias
-// (gnss_ingest). While the robot serves a call, the dispatcher's goal (~call_goal_topic, default call_goal)
-// is the robot's goal and no plan is made; an empty call goal hands the robot back. No ground-truth topic
-// is read. Parameters: config/nbs.yaml.
+// hypothetical posteriors come from the trackers' /pickers/<id>/what_if services. While the robot serves a
+// call, the dispatcher's goal (~call_goal_topic, default call_goal) is the robot's goal and no plan is made;
+// an empty call goal hands the robot back. No ground-truth topic is read. Parameters: config/nbs.yaml.
 #pragma once
 
 #include "picker_localisation/ros/node_diagnostics.h"
@@ -20,7 +18,6 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <picker_localisation/GetCandidates.h>
-#include <picker_localisation/GnssBias.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
 #include <picker_localisation/WhatIf.h>
@@ -58,9 +55,6 @@ class NbsPlannerNode {
     ros::ServiceClient what_if;
     std::optional<picker_localisation::PickerBelief> belief;
     std::size_t received = 0, rejected = 0;
-    ros::Subscriber bias_sub;                        // /pickers/<id>/gnss_bias (lane check only)
-    std::optional<Eigen::Matrix2d> bias_covariance;  // of the last valid GnssBias
-    std::size_t bias_received = 0, bias_rejected = 0;
   };
   struct PeerGoal {
     picker_localisation::GoalNode msg;
@@ -68,7 +62,6 @@ class NbsPlannerNode {
   };
 
   void beliefCallback(const picker_localisation::PickerBelief& msg);
-  void biasCallback(const std::string& picker_id, const picker_localisation::GnssBias::ConstPtr& msg);
   void applyPickerList(const std::vector<std::string>& ids);
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void callGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);

@@ -26,11 +26,9 @@
 //    0: such particles stay (they would wait for a re-initialisation, as nothing else changes their
 //    velocity).
 //  * tau in Eq. 2 is the dwell time at the prediction instant (tau_t + dt); at most one jump per prediction.
-//    With step_consistent_jumps (option; default off = literal) Eq. 2 is read as the probability of having
-//    left the node after dwelling tau, and a step from tau_t to tau_t + dt jumps with the conditional
-//    probability sum_k b_k (exp(l_k tau_t) - exp(l_k (tau_t + dt))) / sum_k b_k exp(l_k tau_t): one 3 s step
-//    and thirty 0.1 s steps move the particles alike (the literal reading applies Eq. 2 afresh at every
-//    observation, so particles would run faster the more sensors report). A step with dt = 0 never jumps.
+//    Eq. 2 is applied afresh at every prediction (the paper read literally): particles move faster the more
+//    often sensors report; a "step-consistent" reading (the conditional jump probability since the last
+//    step) tracked worse with 1 Hz GNSS in our lane-walk trials and was removed (CHANGELOG).
 //  * Eq. 7: on a jump the observed velocity is (p(q') - p(q)) / max(tau_t + dt, min_jump_dwell) (a vector
 //  along
 //    the edge) and v' = v + Pr(q') (v_obs - v) / V with Pr(q') the Eq. 2-3 probability of the transition

@@ -65,12 +65,6 @@ struct TpfParams {
   double velocity_window = 10.0;  // V of Eq. 7 (dimensionless number of steps; not in Table I)
   double min_jump_dwell = 0.1;    // s, floor on the dwell time used for the observed speed of Eq. 7
   bool directed_motion = false;   // true: particles follow file edge direction; false: undirected graph
-  // true: Eq. 2 is the probability of having left the node after dwelling tau, so a prediction step of dt
-  // jumps with the conditional probability 1 - S(tau + dt) / S(tau), S = 1 - Eq. 2 (the motion no longer
-  // depends on how often observations arrive). false (default, paper read literally): Eq. 2 at tau is applied
-  // at every prediction; particles move faster the more sensors report, which tracked better with 1 Hz GNSS
-  // in our lane-walk trials (docs/readme/tpf.md).
-  bool step_consistent_jumps = false;
   // A particle whose velocity projects on no edge by at least this fraction of its speed (no edge within
   // acos(0.2) = 78 deg: lane end, corner) treats every edge as aligned (b = |v|) so it can turn. 0: it stays.
   double turn_projection_fraction = 0.2;
@@ -164,9 +158,6 @@ struct TpfParams {
   // the paper does not use: uwb (1, 0) like RFID (identifying range), camera (0.25, 0) like LiDAR.
   std::map<std::string, SensorGamma> sensor_gammas;
   SensorGamma default_gamma{0.25, 0.0};  // for a sensor missing from sensor_gammas (anonymous, low trust)
-  // false (paper): w_q = gamma_q * L^(q). true: w_q = gamma_q * L^(q) + (1 - gamma_q), i.e. gamma_q is the
-  // confidence in the sensor and a low-confidence sensor only nudges the belief. L^ = L / max L.
-  bool gamma_as_confidence = false;
   // false (paper): w = w_q + w_v. true: w = w_q (1 + w_v), so velocity agreement scales the node term and a
   // particle outside the node likelihood's support keeps weight 0 whatever its velocity.
   bool velocity_weight_product = true;
