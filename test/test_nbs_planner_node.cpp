@@ -278,8 +278,8 @@ TEST(NbsPlannerNode, StaleRobotPoseStopsPlanning) {
   EXPECT_TRUE(counted);
 }
 
-// The planner may only read beliefs, the GNSS bias estimates (gnss_ingest's, lane check), goals, the battery,
-// tf and the clock: never a ground-truth topic.
+// The planner may only read beliefs, the picker list, goals, call goals, the battery, tf and the clock: never
+// a ground-truth topic.
 TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
   XmlRpc::XmlRpcValue args, result, payload;
   args[0] = ros::this_node::getName();
@@ -304,7 +304,6 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
       EXPECT_EQ(t.find("ground_truth"), std::string::npos) << node << " subscribes to " << t;
       const bool allowed =
           (t.rfind("/pickers/", 0) == 0 && t.size() > 7 && t.substr(t.size() - 7) == "/belief") ||
-          (t.rfind("/pickers/", 0) == 0 && t.size() > 10 && t.substr(t.size() - 10) == "/gnss_bias") ||
           t == "/pickers/beliefs" || t == "/pickers/registry" ||
           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") ||
           (t.size() > 10 && t.substr(t.size() - 10) == "/call_goal") || t == "/tf" || t == "/tf_static" ||

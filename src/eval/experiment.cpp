@@ -129,8 +129,9 @@ std::string resolveConfigFile(const std::string& value, const std::string& packa
 }
 
 // The leg_detector node's options from the `leg_detector:` section of config/vision.yaml and, as demo.launch
-// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.42, 0.3 at its 0.5 deg: the
-// classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files override earlier ones.
+// loads it after that file, the simulated-laser overlay config/vision_sim.yaml (leg_threshold 0.42, 0.3 at
+// its 0.5 deg: the classifier was trained on real scans, see docs/readme/sensors_vision.md). Later files
+// override earlier ones.
 std::vector<std::string> visionConfigFiles(const std::string& value) {
   std::vector<std::string> files;
   if (value == "none") return files;
@@ -147,7 +148,6 @@ std::vector<std::string> visionConfigFiles(const std::string& value) {
     if (!item.empty()) files.push_back(item);
   return files;
 }
-
 
 const std::vector<std::string>& allMethodNames() {
   static const std::vector<std::string> names = [] {
@@ -312,8 +312,8 @@ class GraphRun {
   std::unique_ptr<sensors::GnssFleet> gnss_;
   std::unique_ptr<sensors::RfidObservationModel> rfid_;
   std::unique_ptr<vision::LegPipeline> legs_;
-  std::unique_ptr<tpf::TrackerFleet> trackers_;  // Tracker::kTpf
-  UkfMetricTracker ukf_;                         // Tracker::kUkf
+  std::unique_ptr<tpf::TrackerFleet> trackers_;           // Tracker::kTpf
+  UkfMetricTracker ukf_;                                  // Tracker::kUkf
   std::unique_ptr<dispatch::CallDispatcher> dispatcher_;  // Scenario::kCalls
   dispatch::DispatcherNodeOptions dispatcher_options_;
   std::map<std::uint64_t, OpenCall> open_calls_;
@@ -881,6 +881,75 @@ void logUnknownKeys(const RunConfig& config, std::ostream& log) {
 
 }  // namespace
 
+namespace {
+
+// The runs of one method, seeds config.seed + k, over config.jobs threads; the first error is thrown.
+std::vector<RunResult> runSeeds(const std::shared_ptr<const topology::TopologicalMap>& map,
+                                const RunConfig& rc, const ExperimentConfig& config) {
+  std::vector<RunResult> runs(config.runs);
+  std::vector<std::string> errors(config.runs);
+  std::atomic<std::size_t> next{0};
+  auto worker = [&] {
+    for (std::size_t k = next++; k < config.runs; k = next++) {
+      RunConfig r = rc;
+      r.seed = config.seed + k;
+      try {
+        runs[k] = runOnce(map, r);
+      } catch (const std::exception& e) {
+        errors[k] = e.what();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t j = 1; j < std::max<std::size_t>(1, std::min(config.jobs, config.runs)); ++j)
+    pool.emplace_back(worker);
+  worker();
+  for (auto& th : pool) th.join();
+  for (std::size_t k = 0; k < config.runs; ++k)
+    if (!errors[k].empty())
+      throw std::runtime_error("method " + rc.method + " run " + std::to_string(k) + ": " + errors[k]);
+  return runs;
+}
+
+// One calls_<k>.csv per run: every call, scored from the simulator's truth.
+void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    std::ofstream calls(dir / ("calls_" + std::to_string(k) + ".csv"));
+    calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
+             "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row\n";
+    for (const CallRecord& c : runs[k].calls)
+      calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
+            << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
+            << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row << "\n";
+  }
+}
+
+// The LiDAR people and bias sightings of a method's runs, and bias_by_age.csv in its folder.
+void logLidarPeople(const std::vector<RunResult>& runs, const std::string& dir, std::ostream& log) {
+  std::size_t people = 0, identified = 0, wrong = 0, sightings = 0;
+  for (const RunResult& r : runs) {
+    people += r.lidar_detections;
+    identified += r.identified_detections;
+    wrong += r.wrong_identifications;
+    sightings += r.bias_sightings;
+  }
+  log << "    LiDAR people: " << people << ", identified " << identified << " (wrong picker " << wrong
+      << "), bias sightings accepted " << sightings << "\n";
+  std::vector<double> delays;
+  for (const RunResult& r : runs) delays.insert(delays.end(), r.lane_delays.begin(), r.lane_delays.end());
+  if (!delays.empty()) {
+    std::sort(delays.begin(), delays.end());
+    const auto within = std::count_if(delays.begin(), delays.end(), [](double d) { return d <= 30.0; });
+    log << "    first sighting after a first fix or a blackout: " << delays.size()
+        << ", lane right within 30 s in " << std::setprecision(2) << std::fixed
+        << static_cast<double>(within) / delays.size() << ", median " << std::setprecision(1)
+        << delays[delays.size() / 2] << " s" << std::defaultfloat << "\n";
+  }
+  writeBiasByAge((fs::path(dir) / "bias_by_age.csv").string(), runs, log);
+}
+
+}  // namespace
+
 ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log) {
   const auto wall0 = std::chrono::steady_clock::now();
   auto map = std::make_shared<const topology::TopologicalMap>(topology::loadMap(config.map_path));
@@ -910,41 +979,11 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
       continue;
     }
     const auto m0 = std::chrono::steady_clock::now();
-    std::vector<RunResult> runs(config.runs);
-    std::vector<std::string> errors(config.runs);
-    std::atomic<std::size_t> next{0};
-    auto worker = [&] {
-      for (std::size_t k = next++; k < config.runs; k = next++) {
-        RunConfig r = rc;
-        r.seed = config.seed + k;
-        try {
-          runs[k] = runOnce(map, r);
-        } catch (const std::exception& e) {
-          errors[k] = e.what();
-        }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t j = 1; j < std::max<std::size_t>(1, std::min(config.jobs, config.runs)); ++j)
-      pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-    for (std::size_t k = 0; k < config.runs; ++k)
-      if (!errors[k].empty())
-        throw std::runtime_error("method " + method + " run " + std::to_string(k) + ": " + errors[k]);
+    std::vector<RunResult> runs = runSeeds(map, rc, config);
 
     fs::create_directories(fs::path(config.out_dir) / method);
     std::vector<std::vector<ErrorSample>> samples;
-    for (std::size_t k = 0; k < config.runs && config.scenario == Scenario::kCalls; ++k) {
-      std::ofstream calls(fs::path(config.out_dir) / method / ("calls_" + std::to_string(k) + ".csv"));
-      calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
-               "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row\n";
-      for (const CallRecord& c : runs[k].calls)
-        calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
-              << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival
-              << "," << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row
-              << "\n";
-    }
+    if (config.scenario == Scenario::kCalls) writeCallFiles(fs::path(config.out_dir) / method, runs);
     for (std::size_t k = 0; k < config.runs; ++k) {
       writeRunCsv((fs::path(config.out_dir) / method / ("run_" + std::to_string(k) + ".csv")).string(), *map,
                   runs[k].samples);
@@ -964,31 +1003,10 @@ ExperimentResult runExperiment(const ExperimentConfig& config, std::ostream& log
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - m0).count();
     log << "  " << method << ": euclidean " << std::fixed << std::setprecision(2) << row.euclidean_mean
         << " (" << row.euclidean_std << ") m, topological " << row.topological_mean << " ("
-        << row.topological_std << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share << " ("
-        << row.right_lane_share_std << ")"
-        << std::setprecision(1) << "  [" << secs << " s wall]\n"
+        << row.topological_std << ") nodes, right lane " << std::setprecision(3) << row.right_lane_share
+        << " (" << row.right_lane_share_std << ")" << std::setprecision(1) << "  [" << secs << " s wall]\n"
         << std::defaultfloat;
-    if (specOf(method).lidar) {
-      std::size_t people = 0, identified = 0, wrong = 0, sightings = 0;
-      for (const RunResult& r : runs) {
-        people += r.lidar_detections;
-        identified += r.identified_detections;
-        wrong += r.wrong_identifications;
-        sightings += r.bias_sightings;
-      }
-      log << "    LiDAR people: " << people << ", identified " << identified << " (wrong picker " << wrong
-          << "), bias sightings accepted " << sightings << "\n";
-      std::vector<double> delays;
-      for (const RunResult& r : runs) delays.insert(delays.end(), r.lane_delays.begin(), r.lane_delays.end());
-      if (!delays.empty()) {
-        std::sort(delays.begin(), delays.end());
-        const auto within = std::count_if(delays.begin(), delays.end(), [](double d) { return d <= 30.0; });
-        log << "    first sighting after a first fix or a blackout: " << delays.size() << ", lane right within 30 s in "
-            << std::setprecision(2) << std::fixed << static_cast<double>(within) / delays.size() << ", median "
-            << std::setprecision(1) << delays[delays.size() / 2] << " s" << std::defaultfloat << "\n";
-      }
-      writeBiasByAge((fs::path(config.out_dir) / method / "bias_by_age.csv").string(), runs, log);
-    }
+    if (specOf(method).lidar) logLidarPeople(runs, (fs::path(config.out_dir) / method).string(), log);
   }
   std::ostringstream title;
   title << (config.scenario == Scenario::kCalls ? "Calls" : "Table II") << ", scenario "

@@ -74,7 +74,8 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
                                     "on_demand_topics_above",
                                     "demand_poll_period"};
   known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
-  known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(), PickerAssociationOptions::yamlKeys().end());
+  known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
+               PickerAssociationOptions::yamlKeys().end());
   return core::checkOptions(o, y, known, c, unknown);
 }
 
@@ -144,7 +145,8 @@ std::string PickerAssociationOptions::validate() const {
   if (!(min_probability > 0.5 && min_probability <= 1.0))
     return bad("association_min_probability", min_probability, "in (0.5, 1]");
   if (!(min_candidate_probability >= 0.0 && min_candidate_probability < min_probability))
-    return bad("association_min_candidate_probability", min_candidate_probability, "in [0, association_min_probability)");
+    return bad("association_min_candidate_probability", min_candidate_probability,
+               "in [0, association_min_probability)");
   if (!(belief_weight >= 0.0 && belief_weight <= 1.0))
     return bad("association_belief_weight", belief_weight, "in [0, 1]");
   if (!(belief_sigma > 0.0) || !std::isfinite(belief_sigma))
@@ -152,7 +154,8 @@ std::string PickerAssociationOptions::validate() const {
   if (!(max_fix_age > 0.0)) return bad("association_max_fix_age", max_fix_age, "> 0");
   if (!(speed >= 0.0) || !std::isfinite(speed)) return bad("association_speed", speed, "finite and >= 0");
   if (!(max_belief_age > 0.0)) return bad("association_max_belief_age", max_belief_age, "> 0");
-  if (!(belief_lag >= 0.0) || !std::isfinite(belief_lag)) return bad("association_belief_lag", belief_lag, "finite and >= 0");
+  if (!(belief_lag >= 0.0) || !std::isfinite(belief_lag))
+    return bad("association_belief_lag", belief_lag, "finite and >= 0");
   if (!(identity_window > 0.0) || !std::isfinite(identity_window))
     return bad("association_identity_window", identity_window, "finite and > 0");
   if (!(identity_floor > 0.0 && identity_floor <= 1.0))
@@ -202,6 +205,92 @@ double GnssIngest::ageOfLastFix(double now) const {
   return last_ ? now - last_->stamp : std::numeric_limits<double>::infinity();
 }
 
+// The fix's horizontal covariance (the ENU east-north block of the row-major 3x3; default_sigma when the unit
+// reports none). False with the rejection and its reason when it is unusable.
+bool GnssIngest::horizontalCovariance(const core::GnssFix& fix, Eigen::Matrix2d& c_en,
+                                      GnssRejection& rejection, std::string& why) const {
+  auto fail = [&](GnssRejection r, const char* reason) {
+    rejection = r;
+    why = reason;
+    return false;
+  };
+  if (fix.covariance_type <= 0) {
+    c_en = Eigen::Matrix2d::Identity() * options_.default_sigma * options_.default_sigma;
+  } else {
+    c_en << fix.position_covariance[0], fix.position_covariance[1], fix.position_covariance[3],
+        fix.position_covariance[4];
+    if (!c_en.allFinite()) return fail(GnssRejection::kNotFinite, "covariance is NaN/Inf");
+    if (c_en(0, 0) < 0.0 || c_en(1, 1) < 0.0)
+      return fail(GnssRejection::kNegativeCovariance, "negative variance in the covariance");
+    // DIAGONAL_KNOWN: off-diagonal terms are meaningless by definition.
+    if (fix.covariance_type == 2) c_en(0, 1) = c_en(1, 0) = 0.0;
+    c_en = 0.5 * (c_en + c_en.transpose());
+    if (!core::isCovariance2d(c_en))
+      return fail(GnssRejection::kNegativeCovariance, "horizontal covariance is not positive semi-definite");
+  }
+  return true;
+}
+
+// The gate against impossible jumps from the last accepted fix (Mahalanobis distance with the two fixes'
+// covariances and max_speed * dt of motion). A jump that persists for jump_reset_count fixes re-anchors
+// the gate (the reference was the outlier, or the picker really moved). False with the reason when the fix
+// fails.
+bool GnssIngest::passesJumpGate(const Eigen::Vector2d& p, const Eigen::Matrix2d& c_map, double dt,
+                                std::string& why) {
+  if (!(options_.jump_gate_sigmas > 0.0)) return true;
+  const Eigen::Vector2d d = p - last_->position;
+  const double reach = options_.max_speed * dt;
+  const Eigen::Matrix2d c = last_->covariance + c_map + reach * reach * Eigen::Matrix2d::Identity();
+  const double m2 = d.dot(c.inverse() * d);
+  if (m2 <= options_.jump_gate_sigmas * options_.jump_gate_sigmas) return true;
+  ++consecutive_jumps_;
+  if (consecutive_jumps_ < options_.jump_reset_count || options_.jump_reset_count == 0) {
+    std::ostringstream s;
+    s << "jump of " << d.norm() << " m in " << dt << " s fails the gate (Mahalanobis " << std::sqrt(m2)
+      << " > " << options_.jump_gate_sigmas << ")";
+    why = s.str();
+    return false;
+  }
+  ++counters_.gate_resets;
+  window_.clear();
+  return true;
+}
+
+// The identifying observation of an accepted fix at map position p: bias removed when the estimate is usable.
+core::Observation GnssIngest::observationOf(double stamp, const Eigen::Vector2d& p,
+                                            const Eigen::Matrix2d& c_map, bool* bias_corrected) const {
+  core::Observation obs;
+  obs.stamp = stamp;
+  obs.sensor = options_.sensor;
+  obs.picker_id = picker_id_;
+  obs.identifying = true;
+  core::GaussianLikelihoodOptions lo = options_.likelihoodOptions();
+  if (bias_.usable(stamp)) {
+    // Bias removed (Khan et al. 2020, Sec. VI): the fix minus the estimate, with the estimate's own
+    // uncertainty in place of the unit's reported one (which is mostly the bias itself).
+    const double r2 = options_.bias.residual_std * options_.bias.residual_std;
+    lo.min_sigma = options_.bias.min_sigma;
+    const Eigen::Vector2d corrected = p - bias_.bias(stamp);
+    obs.position = corrected;
+    obs.position_covariance =
+        options_.bias.error_inflation * bias_.covariance(stamp) + r2 * Eigen::Matrix2d::Identity();
+    *bias_corrected = true;
+  } else {
+    obs.position = p;
+    obs.position_covariance = c_map;
+  }
+  // What was removed and how well it is known: the TPF's per-particle bias state starts from it.
+  obs.bias_removed = bias_.applied(stamp);
+  obs.bias_covariance = bias_.appliedCovariance(stamp);
+  obs.bias_drift_rate = options_.bias.driftRate();
+  core::setGaussianLikelihood(obs, *map_, *obs.position, obs.position_covariance, lo);
+  if (options_.velocity_window >= 2 && window_.size() >= 2) {
+    const double span = window_.back().stamp - window_.front().stamp;
+    if (span > 0.0) obs.velocity = (window_.back().position - window_.front().position) / span;
+  }
+  return obs;
+}
+
 GnssResult GnssIngest::process(const core::GnssFix& fix) {
   GnssResult result;
   ++counters_.received;
@@ -218,25 +307,13 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
   if (std::abs(fix.latitude) > 90.0 || std::abs(fix.longitude) > 180.0)
     return reject(GnssRejection::kNotFinite, "latitude / longitude out of range", counters_.not_finite);
 
-  // Horizontal covariance (ENU east-north block of the row-major 3x3).
   Eigen::Matrix2d c_en;
-  if (fix.covariance_type <= 0) {
-    c_en = Eigen::Matrix2d::Identity() * options_.default_sigma * options_.default_sigma;
-  } else {
-    c_en << fix.position_covariance[0], fix.position_covariance[1], fix.position_covariance[3],
-        fix.position_covariance[4];
-    if (!c_en.allFinite())
-      return reject(GnssRejection::kNotFinite, "covariance is NaN/Inf", counters_.not_finite);
-    if (c_en(0, 0) < 0.0 || c_en(1, 1) < 0.0)
-      return reject(GnssRejection::kNegativeCovariance, "negative variance in the covariance",
-                    counters_.negative_covariance);
-    // DIAGONAL_KNOWN: off-diagonal terms are meaningless by definition.
-    if (fix.covariance_type == 2) c_en(0, 1) = c_en(1, 0) = 0.0;
-    c_en = 0.5 * (c_en + c_en.transpose());
-    if (!core::isCovariance2d(c_en))
-      return reject(GnssRejection::kNegativeCovariance, "horizontal covariance is not positive semi-definite",
-                    counters_.negative_covariance);
-  }
+  GnssRejection bad_covariance = GnssRejection::kNone;
+  std::string why;
+  if (!horizontalCovariance(fix, c_en, bad_covariance, why))
+    return reject(
+        bad_covariance, why,
+        bad_covariance == GnssRejection::kNotFinite ? counters_.not_finite : counters_.negative_covariance);
   // Floor each axis (the likelihood also floors the eigenvalues).
   const double floor = options_.min_sigma * options_.min_sigma;
   c_en(0, 0) = std::max(c_en(0, 0), floor);
@@ -255,7 +332,8 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
 
   if (double off = 0.0; options_.farFromMap(*map_, p, &off)) {
     std::ostringstream s;
-    s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance << " m)";
+    s << "fix " << off << " m from the nearest map node (max_map_distance " << options_.max_map_distance
+      << " m)";
     return reject(GnssRejection::kOffMap, s.str(), counters_.off_map);
   }
 
@@ -263,24 +341,8 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
   if (last_) {
     const double dt = fix.stamp - last_->stamp;
     after_blackout = dt > options_.blackout_timeout;
-    if (!after_blackout && options_.jump_gate_sigmas > 0.0) {
-      const Eigen::Vector2d d = p - last_->position;
-      const double reach = options_.max_speed * dt;
-      const Eigen::Matrix2d c = last_->covariance + c_map + reach * reach * Eigen::Matrix2d::Identity();
-      const double m2 = d.dot(c.inverse() * d);
-      if (m2 > options_.jump_gate_sigmas * options_.jump_gate_sigmas) {
-        ++consecutive_jumps_;
-        if (consecutive_jumps_ < options_.jump_reset_count || options_.jump_reset_count == 0) {
-          std::ostringstream s;
-          s << "jump of " << d.norm() << " m in " << dt << " s fails the gate (Mahalanobis " << std::sqrt(m2)
-            << " > " << options_.jump_gate_sigmas << ")";
-          return reject(GnssRejection::kImpossibleJump, s.str(), counters_.impossible_jump);
-        }
-        // Persistent "jump": the reference was the outlier (or the picker really moved): re-anchor.
-        ++counters_.gate_resets;
-        window_.clear();
-      }
-    }
+    if (!after_blackout && !passesJumpGate(p, c_map, dt, why))
+      return reject(GnssRejection::kImpossibleJump, why, counters_.impossible_jump);
   }
   consecutive_jumps_ = 0;
   if (after_blackout) {
@@ -297,36 +359,7 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
   while (recent_.size() > kRecentFixes) recent_.pop_front();
   ++counters_.accepted;
 
-  core::Observation obs;
-  obs.stamp = fix.stamp;
-  obs.sensor = options_.sensor;
-  obs.picker_id = picker_id_;
-  obs.identifying = true;
-  core::GaussianLikelihoodOptions lo = options_.likelihoodOptions();
-  if (bias_.usable(fix.stamp)) {
-    // Bias removed (Khan et al. 2020, Sec. VI): the fix minus the estimate, with the estimate's own uncertainty in
-    // place of the unit's reported one (which is mostly the bias itself).
-    const double r2 = options_.bias.residual_std * options_.bias.residual_std;
-    lo.min_sigma = options_.bias.min_sigma;
-    const Eigen::Vector2d corrected = p - bias_.bias(fix.stamp);
-    obs.position = corrected;
-    obs.position_covariance =
-        options_.bias.error_inflation * bias_.covariance(fix.stamp) + r2 * Eigen::Matrix2d::Identity();
-    result.bias_corrected = true;
-  } else {
-    obs.position = p;
-    obs.position_covariance = c_map;
-  }
-  // What was removed and how well it is known: the TPF's per-particle bias state starts from it.
-  obs.bias_removed = bias_.applied(fix.stamp);
-  obs.bias_covariance = bias_.appliedCovariance(fix.stamp);
-  obs.bias_drift_rate = options_.bias.driftRate();
-  core::setGaussianLikelihood(obs, *map_, *obs.position, obs.position_covariance, lo);
-  if (options_.velocity_window >= 2 && window_.size() >= 2) {
-    const double span = window_.back().stamp - window_.front().stamp;
-    if (span > 0.0) obs.velocity = (window_.back().position - window_.front().position) / span;
-  }
-  result.observation = std::move(obs);
+  result.observation = observationOf(fix.stamp, p, c_map, &result.bias_corrected);
   return result;
 }
 

@@ -38,6 +38,87 @@ void applySection(const YAML::Node& node, const std::map<std::string, Setter>& k
   }
 }
 
+std::map<std::string, Setter> pickerMotionKeys(SimConfig& c) {
+  return {{"speed_mean", set(c.picker_motion.speed_mean)},
+          {"speed_std", set(c.picker_motion.speed_std)},
+          {"speed_min", set(c.picker_motion.speed_min)},
+          {"speed_max", set(c.picker_motion.speed_max)},
+          {"p_reverse", set(c.picker_motion.p_reverse)},
+          {"t_reverse", set(c.picker_motion.t_reverse)},
+          {"reverse_step", set(c.picker_motion.reverse_step)},
+          {"dwell_mean", set(c.picker_motion.dwell_mean)},
+          {"long_stop_probability", set(c.picker_motion.long_stop_probability)},
+          {"long_stop_mean", set(c.picker_motion.long_stop_mean)},
+          {"lane_order",
+           [&c](const YAML::Node& n) { c.picker_motion.lane_order = parseLaneOrder(n.as<std::string>()); }},
+          {"leg_radius", set(c.picker_motion.leg_radius)},
+          {"leg_spread", set(c.picker_motion.leg_spread)},
+          {"stride_length", set(c.picker_motion.stride_length)},
+          {"step_amplitude", set(c.picker_motion.step_amplitude)}};
+}
+
+std::map<std::string, Setter> gnssKeys(SimConfig& c) {
+  return {{"offset_min", set(c.gnss.offset_min)},
+          {"offset_max", set(c.gnss.offset_max)},
+          {"white_std", set(c.gnss.white_std)},
+          {"drift_std", set(c.gnss.drift_std)},
+          {"drift_tau", set(c.gnss.drift_tau)},
+          {"blackout_mean_interval", set(c.gnss.blackout_mean_interval)},
+          {"blackout_min", set(c.gnss.blackout_min)},
+          {"blackout_max", set(c.gnss.blackout_max)},
+          {"blackout_emits_no_fix", set(c.gnss.blackout_emits_no_fix)},
+          {"redraw_after_blackout", set(c.gnss.redraw_after_blackout)},
+          {"rate", set(c.gnss.rate)},
+          {"reported_std", set(c.gnss.reported_std)},
+          {"antenna_height", set(c.gnss.antenna_height)}};
+}
+
+std::map<std::string, Setter> laserKeys(SimConfig& c) {
+  return {{"angle_min", set(c.laser.angle_min)},
+          {"angle_max", set(c.laser.angle_max)},
+          {"angle_increment", set(c.laser.angle_increment)},
+          {"range_min", set(c.laser.range_min)},
+          {"range_max", set(c.laser.range_max)},
+          {"range_noise_std", set(c.laser.range_noise_std)},
+          {"rate", set(c.laser.rate)}};
+}
+
+std::map<std::string, Setter> rfidKeys(SimConfig& c) {
+  return {{"p_max", set(c.rfid.p_max)},
+          {"d50", set(c.rfid.d50)},
+          {"width", set(c.rfid.width)},
+          {"max_range", set(c.rfid.max_range)},
+          {"rssi_1m", set(c.rfid.rssi_1m)},
+          {"path_loss_exponent", set(c.rfid.path_loss_exponent)},
+          {"rssi_std", set(c.rfid.rssi_std)},
+          {"wavelength", set(c.rfid.wavelength)},
+          {"phase_std", set(c.rfid.phase_std)},
+          {"tag_height", set(c.rfid.tag_height)},
+          {"rate", set(c.rfid.rate)}};
+}
+
+std::map<std::string, Setter> uwbKeys(SimConfig& c) {
+  return {{"range_std", set(c.uwb.range_std)},
+          {"p_nlos", set(c.uwb.p_nlos)},
+          {"nlos_mean", set(c.uwb.nlos_mean)},
+          {"p_dropout", set(c.uwb.p_dropout)},
+          {"max_range", set(c.uwb.max_range)},
+          {"tag_height", set(c.uwb.tag_height)},
+          {"rate", set(c.uwb.rate)}};
+}
+
+std::map<std::string, Setter> cameraKeys(SimConfig& c) {
+  return {{"image_width", set(c.camera.image_width)},
+          {"image_height", set(c.camera.image_height)},
+          {"hfov", set(c.camera.hfov)},
+          {"max_range", set(c.camera.max_range)},
+          {"p_miss", set(c.camera.p_miss)},
+          {"pixel_std", set(c.camera.pixel_std)},
+          {"person_height", set(c.camera.person_height)},
+          {"person_width", set(c.camera.person_width)},
+          {"rate", set(c.camera.rate)}};
+}
+
 }  // namespace
 
 void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::string& source) {
@@ -54,39 +135,8 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
       {"robots", set(c.num_robots)},
       {"robot_ids", set(c.robot_ids)},
       {"robot_start_nodes", set(c.robot_start_nodes)},
-      {"picker_motion", section({{"speed_mean", set(c.picker_motion.speed_mean)},
-                                 {"speed_std", set(c.picker_motion.speed_std)},
-                                 {"speed_min", set(c.picker_motion.speed_min)},
-                                 {"speed_max", set(c.picker_motion.speed_max)},
-                                 {"p_reverse", set(c.picker_motion.p_reverse)},
-                                 {"t_reverse", set(c.picker_motion.t_reverse)},
-                                 {"reverse_step", set(c.picker_motion.reverse_step)},
-                                 {"dwell_mean", set(c.picker_motion.dwell_mean)},
-                                 {"long_stop_probability", set(c.picker_motion.long_stop_probability)},
-                                 {"long_stop_mean", set(c.picker_motion.long_stop_mean)},
-                                 {"lane_order",
-                                  [&c](const YAML::Node& n) {
-                                    c.picker_motion.lane_order = parseLaneOrder(n.as<std::string>());
-                                  }},
-                                 {"leg_radius", set(c.picker_motion.leg_radius)},
-                                 {"leg_spread", set(c.picker_motion.leg_spread)},
-                                 {"stride_length", set(c.picker_motion.stride_length)},
-                                 {"step_amplitude", set(c.picker_motion.step_amplitude)}},
-                                "picker_motion")},
-      {"gnss", section({{"offset_min", set(c.gnss.offset_min)},
-                        {"offset_max", set(c.gnss.offset_max)},
-                        {"white_std", set(c.gnss.white_std)},
-                        {"drift_std", set(c.gnss.drift_std)},
-                        {"drift_tau", set(c.gnss.drift_tau)},
-                        {"blackout_mean_interval", set(c.gnss.blackout_mean_interval)},
-                        {"blackout_min", set(c.gnss.blackout_min)},
-                        {"blackout_max", set(c.gnss.blackout_max)},
-                        {"blackout_emits_no_fix", set(c.gnss.blackout_emits_no_fix)},
-                        {"redraw_after_blackout", set(c.gnss.redraw_after_blackout)},
-                        {"rate", set(c.gnss.rate)},
-                        {"reported_std", set(c.gnss.reported_std)},
-                        {"antenna_height", set(c.gnss.antenna_height)}},
-                       "gnss")},
+      {"picker_motion", section(pickerMotionKeys(c), "picker_motion")},
+      {"gnss", section(gnssKeys(c), "gnss")},
       {"datum",
        [&c, &source](const YAML::Node& n) {  // config/datum.yaml's keys (core::DatumConfig)
          std::vector<std::string> unknown;
@@ -99,44 +149,10 @@ void applySimConfigYaml(const YAML::Node& root_in, SimConfig& c, const std::stri
                                    c.robot_motion.patrol = parsePatrolPolicy(n.as<std::string>());
                                  }}},
                                "robot_motion")},
-      {"laser", section({{"angle_min", set(c.laser.angle_min)},
-                         {"angle_max", set(c.laser.angle_max)},
-                         {"angle_increment", set(c.laser.angle_increment)},
-                         {"range_min", set(c.laser.range_min)},
-                         {"range_max", set(c.laser.range_max)},
-                         {"range_noise_std", set(c.laser.range_noise_std)},
-                         {"rate", set(c.laser.rate)}},
-                        "laser")},
-      {"rfid", section({{"p_max", set(c.rfid.p_max)},
-                        {"d50", set(c.rfid.d50)},
-                        {"width", set(c.rfid.width)},
-                        {"max_range", set(c.rfid.max_range)},
-                        {"rssi_1m", set(c.rfid.rssi_1m)},
-                        {"path_loss_exponent", set(c.rfid.path_loss_exponent)},
-                        {"rssi_std", set(c.rfid.rssi_std)},
-                        {"wavelength", set(c.rfid.wavelength)},
-                        {"phase_std", set(c.rfid.phase_std)},
-                        {"tag_height", set(c.rfid.tag_height)},
-                        {"rate", set(c.rfid.rate)}},
-                       "rfid")},
-      {"uwb", section({{"range_std", set(c.uwb.range_std)},
-                       {"p_nlos", set(c.uwb.p_nlos)},
-                       {"nlos_mean", set(c.uwb.nlos_mean)},
-                       {"p_dropout", set(c.uwb.p_dropout)},
-                       {"max_range", set(c.uwb.max_range)},
-                       {"tag_height", set(c.uwb.tag_height)},
-                       {"rate", set(c.uwb.rate)}},
-                      "uwb")},
-      {"camera", section({{"image_width", set(c.camera.image_width)},
-                          {"image_height", set(c.camera.image_height)},
-                          {"hfov", set(c.camera.hfov)},
-                          {"max_range", set(c.camera.max_range)},
-                          {"p_miss", set(c.camera.p_miss)},
-                          {"pixel_std", set(c.camera.pixel_std)},
-                          {"person_height", set(c.camera.person_height)},
-                          {"person_width", set(c.camera.person_width)},
-                          {"rate", set(c.camera.rate)}},
-                         "camera")},
+      {"laser", section(laserKeys(c), "laser")},
+      {"rfid", section(rfidKeys(c), "rfid")},
+      {"uwb", section(uwbKeys(c), "uwb")},
+      {"camera", section(cameraKeys(c), "camera")},
       {"clutter", section({{"bed_posts", set(c.clutter.bed_posts)},
                            {"post_spacing", set(c.clutter.post_spacing)},
                            {"post_offset", set(c.clutter.post_offset)},

@@ -307,7 +307,8 @@ TopologicalParticleFilter::TopologicalParticleFilter(std::shared_ptr<const topol
 }
 
 void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::TopologicalMap> map) {
-  // What can throw (std::bad_alloc) first, into locals; then no-throw swaps: a failure leaves the filter as it was.
+  // What can throw (std::bad_alloc) first, into locals; then no-throw swaps: a failure leaves the filter as
+  // it was.
   auto graph = std::make_shared<const MotionGraph>(
       *map, params_.directed_motion,
       params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
@@ -316,7 +317,8 @@ void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::Topologic
           ? params_.lane_swap_max_distance
           : 0.0);
   std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
-  std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0), node_b(map->numNodes(), 0.0);
+  std::vector<double> projection(edge.size(), 0.0), node_a(map->numNodes(), 0.0),
+      node_b(map->numNodes(), 0.0);
   std::vector<double> lanes(map->numLanes(), 0.0);
   map_.swap(map);
   graph_.swap(graph);
@@ -584,154 +586,189 @@ void TopologicalParticleFilter::redraw(const core::Observation& obs, std::size_t
 void TopologicalParticleFilter::predict(double dt) {
   // Eqs. 2-7, one jump at most per particle and step; see the header for the reading of Eqs. 3 and 7.
   // The same pass counts the predicted particles per node (node_scratch_b_, touched_) for the JSD / belief.
-  const MotionGraph& g = *graph_;
-  const double inv_window = 1.0 / params_.velocity_window;
-  std::vector<double>& count = node_scratch_b_;
   touched_.clear();
   if (params_.motion_model == MotionModel::kFixedLambda) {
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
-      Particle& p = particles_[i];
-      const double tau = static_cast<double>(p.dwell) + dt;
-      const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
-      const std::uint64_t bits = rng_();
-      spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
-      const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32;
-      // Exponential dwell (Khan et al. 2020): the cumulative 1 - exp(-lambda tau) at every step, Eq. 2 read
-      // literally.
-      const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
-      if (begin == end || !(u < r)) {
-        p.dwell = static_cast<float>(tau);
-      } else {
-        // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
-        const std::uint32_t k =
-            begin +
-            std::min<std::uint32_t>(end - begin - 1, static_cast<std::uint32_t>((u / r) * (end - begin)));
-        p.node = g.arcs[k].target;
-        p.dwell = 0.0f;
-      }
-      if (count[p.node] == 0.0) touched_.push_back(p.node);
-      count[p.node] += 1.0;
-    }
+    predictFixedLambda(dt);
     return;
   }
-  // Not in the paper: pickers turn round in the middle of a lane (Table I p_reverse). Without a turn the
-  // velocity model cannot follow them (the back edge has b = 0), so each particle reverses its velocity with
-  // probability 1 - exp(-reverse_rate dt) per step (geometric gaps: one draw per reversing particle).
-  if (params_.reverse_rate > 0.0 && dt > 0.0) {
-    const double p_rev = 1.0 - std::exp(-params_.reverse_rate * dt);
-    if (p_rev > 0.0) {
-      std::geometric_distribution<std::size_t> gap(std::min(p_rev, 1.0));
-      for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
-        particles_[i].vx = -particles_[i].vx;
-        particles_[i].vy = -particles_[i].vy;
-      }
-    }
+  reverseSomeVelocities(dt);
+  std::vector<double>& count = node_scratch_b_;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    moveWithVelocityModel(i, dt);
+    const NodeIndex n = particles_[i].node;
+    if (count[n] == 0.0) touched_.push_back(n);
+    count[n] += 1.0;
   }
-  std::vector<double>& contrib = edge_scratch_;  // (sized to the largest degree at construction)
-  std::vector<double>& proj = projection_scratch_;
-  const double turn_fraction = params_.turn_projection_fraction;
-  const bool follow_edge = params_.velocity_follows_edge;
-  const double leak = params_.lane_change_leak;
-  const double keep = params_.lane_change_keep_side;
+}
+
+void TopologicalParticleFilter::predictFixedLambda(double dt) {
+  // Khan et al. 2020: every particle leaves its node at the fixed rate lambda, to a neighbour chosen
+  // uniformly.
+  const MotionGraph& g = *graph_;
+  std::vector<double>& count = node_scratch_b_;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     Particle& p = particles_[i];
     const double tau = static_cast<double>(p.dwell) + dt;
     const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
-    const double vx = p.vx, vy = p.vy;
     const std::uint64_t bits = rng_();
     spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
-    // Per arc: b (Eq. 2) and the survival e1 = exp(lambda tau) at the dwell reached. Jump to k in this step
-    // with probability b_k (1 - e1_k) / sum b: Eqs. 2-3 at tau, read literally.
-    // Turning: when no edge lies within acos(turn_fraction) of the velocity (lane end, corner into the
-    // headland), every edge gets b = |v| (see turn_projection_fraction).
-    // On a lane-change path: the path's next node gets b = |v|, every other edge lane_change_leak |v|.
-    NodeIndex path_next = topology::kInvalidNode;
-    if (p.lane_change != 0) {
-      const auto& path = g.lane_paths[p.lane_change - 1];
-      const auto at = std::find(path.begin(), path.end(), p.node);
-      if (at != path.end() && at + 1 != path.end())
-        path_next = *(at + 1);
-      else
-        p.lane_change = 0;
-    }
-    double max_proj = 0.0;
-    if (path_next != topology::kInvalidNode) {
-      const double speed = std::sqrt(vx * vx + vy * vy);
-      for (std::uint32_t e = begin; e < end; ++e)
-        proj[e - begin] =
-            g.arcs[e].length > 0.0 ? (g.arcs[e].target == path_next ? speed : leak * speed) : 0.0;
-      max_proj = speed;
-    } else {
-      for (std::uint32_t e = begin; e < end; ++e) {
-        const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
-        proj[e - begin] = b;
-        max_proj = std::max(max_proj, b);
-      }
-    }
-    if (path_next == topology::kInvalidNode && max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
-      const double speed = std::sqrt(vx * vx + vy * vy);
-      for (std::uint32_t e = begin; e < end; ++e) proj[e - begin] = g.arcs[e].length > 0.0 ? speed : 0.0;
-      if (p.last_lane_change != 0 && keep != 0.5)  // side memory: the remembered side's exit weighs more
-        for (std::uint32_t e = begin; e < end; ++e)
-          if (proj[e - begin] > 0.0)
-            proj[e - begin] *= g.exitWeight(p.node, g.arcs[e].target, p.last_lane_change, keep);
-    }
-    double sum_b = 0.0, sum_c = 0.0;
-    for (std::uint32_t e = begin; e < end; ++e) {
-      const auto& arc = g.arcs[e];
-      const double b = proj[e - begin];
-      double c = 0.0;
-      if (b > 0.0) {
-        // exp(lambda tau), lambda of Eq. 6; single precision is ample for a probability and twice as fast.
-        const double e1 = std::exp(static_cast<float>(arc.rate * b * tau));
-        c = b * (1.0 - e1);
-        proj[e - begin] = b * (1.0 - e1);  // b is no longer needed: keep Eq. 2-3's term for Eq. 7
-      } else {
-        proj[e - begin] = 0.0;
-      }
-      contrib[e - begin] = c;
-      sum_b += b;
-      sum_c += c;
-    }
-    const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32 * sum_b;  // jump w.p. sum_c / sum_b
-    if (!(u < sum_c)) {
+    const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32;
+    // Exponential dwell (Khan et al. 2020): the cumulative 1 - exp(-lambda tau) at every step, Eq. 2 read
+    // literally.
+    const double r = 1.0 - std::exp(-params_.fixed_lambda * tau);
+    if (begin == end || !(u < r)) {
       p.dwell = static_cast<float>(tau);
     } else {
-      std::uint32_t e = begin;
-      double acc = contrib[0];
-      while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
-      // Pr(q') of Eq. 7: Eq. 2-3 probability of the transition taken at the dwell reached (rate independent).
-      const double pr = proj[e - begin] / sum_b;
-      const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
-      const auto& arc = g.arcs[e];
-      const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
-      if (follow_edge) {
-        // Departure from Eq. 7 (velocity_follows_edge): Eq. 7 smooths the speed only; the heading becomes the
-        // edge taken, so a particle that turned (lane end, headland corner) keeps walking the way it turned
-        // instead of pointing back along the lane it left for ~V jumps.
-        const double speed = std::sqrt(vx * vx + vy * vy);
-        const double s = speed + pr * (arc.length * inv_t - speed) * inv_window;
-        p.vx = static_cast<float>(arc.ux * s);
-        p.vy = static_cast<float>(arc.uy * s);
-      } else {
-        p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
-        p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
-      }
-      const NodeIndex from = p.node;
-      p.node = arc.target;
+      // u / r is uniform in [0, 1) given a jump: reuse it to pick the neighbour.
+      const std::uint32_t k =
+          begin +
+          std::min<std::uint32_t>(end - begin - 1, static_cast<std::uint32_t>((u / r) * (end - begin)));
+      p.node = g.arcs[k].target;
       p.dwell = 0.0f;
-      if (path_next != topology::kInvalidNode) {
-        // Followed the path (ends one node inside the new lane) or left it.
-        const auto& path = g.lane_paths[p.lane_change - 1];
-        if (arc.target == path_next && path.back() == arc.target) p.last_lane_change = p.lane_change;
-        if (arc.target != path_next || path.back() == arc.target) p.lane_change = 0;
-      } else if (map_->lane(arc.target) != map_->lane(from)) {
-        // Left the lane at an end?
-        p.lane_change = g.exitPathStartingWith(from, arc.target, rng_, p.last_lane_change, keep);
-      }
     }
     if (count[p.node] == 0.0) touched_.push_back(p.node);
     count[p.node] += 1.0;
+  }
+}
+
+void TopologicalParticleFilter::reverseSomeVelocities(double dt) {
+  // Not in the paper: pickers turn round in the middle of a lane (Table I p_reverse). Without a turn the
+  // velocity model cannot follow them (the back edge has b = 0), so each particle reverses its velocity with
+  // probability 1 - exp(-reverse_rate dt) per step (geometric gaps: one draw per reversing particle).
+  if (!(params_.reverse_rate > 0.0 && dt > 0.0)) return;
+  const double p_rev = 1.0 - std::exp(-params_.reverse_rate * dt);
+  if (!(p_rev > 0.0)) return;
+  std::geometric_distribution<std::size_t> gap(std::min(p_rev, 1.0));
+  for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
+    particles_[i].vx = -particles_[i].vx;
+    particles_[i].vy = -particles_[i].vy;
+  }
+}
+
+void TopologicalParticleFilter::moveWithVelocityModel(std::size_t i, double dt) {
+  // Eqs. 2-7 for one particle: at most one jump per step.
+  const MotionGraph& g = *graph_;
+  std::vector<double>& contrib = edge_scratch_;  // (sized to the largest degree at construction)
+  std::vector<double>& proj = projection_scratch_;
+  Particle& p = particles_[i];
+  const double tau = static_cast<double>(p.dwell) + dt;
+  const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
+  const std::uint64_t bits = rng_();
+  spare_bits_[i] = static_cast<std::uint32_t>(bits >> 32);
+  // Per arc: b (Eq. 2) and the survival e1 = exp(lambda tau) at the dwell reached. Jump to k in this step
+  // with probability b_k (1 - e1_k) / sum b: Eqs. 2-3 at tau, read literally.
+  const NodeIndex path_next = projectOnEdges(p);
+  double sum_b = 0.0, sum_c = 0.0;
+  for (std::uint32_t e = begin; e < end; ++e) {
+    const auto& arc = g.arcs[e];
+    const double b = proj[e - begin];
+    double c = 0.0;
+    if (b > 0.0) {
+      // exp(lambda tau), lambda of Eq. 6; single precision is ample for a probability and twice as fast.
+      const double e1 = std::exp(static_cast<float>(arc.rate * b * tau));
+      c = b * (1.0 - e1);
+      proj[e - begin] = b * (1.0 - e1);  // b is no longer needed: keep Eq. 2-3's term for Eq. 7
+    } else {
+      proj[e - begin] = 0.0;
+    }
+    contrib[e - begin] = c;
+    sum_b += b;
+    sum_c += c;
+  }
+  const double u = static_cast<double>(bits & 0xffffffffu) * 0x1.0p-32 * sum_b;  // jump w.p. sum_c / sum_b
+  if (!(u < sum_c)) {
+    p.dwell = static_cast<float>(tau);
+  } else {
+    std::uint32_t e = begin;
+    double acc = contrib[0];
+    while (acc <= u && e + 1 < end) acc += contrib[++e - begin];
+    // Pr(q') of Eq. 7: Eq. 2-3 probability of the transition taken at the dwell reached (rate independent).
+    const double pr = proj[e - begin] / sum_b;
+    jumpAlong(p, e, pr, tau, path_next);
+  }
+}
+
+// b of Eq. 2 for every edge out of p's node, in projection_scratch_; returns the next node of p's lane-change
+// path (kInvalidNode when it follows none; a path p has left is forgotten).
+NodeIndex TopologicalParticleFilter::projectOnEdges(Particle& p) {
+  const MotionGraph& g = *graph_;
+  std::vector<double>& proj = projection_scratch_;
+  const std::uint32_t begin = g.offsets[p.node], end = g.offsets[p.node + 1];
+  const double vx = p.vx, vy = p.vy;
+  const double leak = params_.lane_change_leak;
+  const double keep = params_.lane_change_keep_side;
+  const double turn_fraction = params_.turn_projection_fraction;
+  // Turning: when no edge lies within acos(turn_fraction) of the velocity (lane end, corner into the
+  // headland), every edge gets b = |v| (see turn_projection_fraction).
+  // On a lane-change path: the path's next node gets b = |v|, every other edge lane_change_leak |v|.
+  NodeIndex path_next = topology::kInvalidNode;
+  if (p.lane_change != 0) {
+    const auto& path = g.lane_paths[p.lane_change - 1];
+    const auto at = std::find(path.begin(), path.end(), p.node);
+    if (at != path.end() && at + 1 != path.end())
+      path_next = *(at + 1);
+    else
+      p.lane_change = 0;
+  }
+  double max_proj = 0.0;
+  if (path_next != topology::kInvalidNode) {
+    const double speed = std::sqrt(vx * vx + vy * vy);
+    for (std::uint32_t e = begin; e < end; ++e)
+      proj[e - begin] = g.arcs[e].length > 0.0 ? (g.arcs[e].target == path_next ? speed : leak * speed) : 0.0;
+    max_proj = speed;
+  } else {
+    for (std::uint32_t e = begin; e < end; ++e) {
+      const double b = std::max(0.0, vx * g.arcs[e].ux + vy * g.arcs[e].uy);
+      proj[e - begin] = b;
+      max_proj = std::max(max_proj, b);
+    }
+  }
+  if (path_next == topology::kInvalidNode && max_proj < turn_fraction * std::sqrt(vx * vx + vy * vy)) {
+    const double speed = std::sqrt(vx * vx + vy * vy);
+    for (std::uint32_t e = begin; e < end; ++e) proj[e - begin] = g.arcs[e].length > 0.0 ? speed : 0.0;
+    if (p.last_lane_change != 0 && keep != 0.5)  // side memory: the remembered side's exit weighs more
+      for (std::uint32_t e = begin; e < end; ++e)
+        if (proj[e - begin] > 0.0)
+          proj[e - begin] *= g.exitWeight(p.node, g.arcs[e].target, p.last_lane_change, keep);
+  }
+  return path_next;
+}
+
+// The jump of Eq. 7 along arc e (Eq. 2-3 probability pr) after dwelling tau: the velocity update, the node,
+// and the lane-change path followed or begun.
+void TopologicalParticleFilter::jumpAlong(Particle& p, std::uint32_t e, double pr, double tau,
+                                          NodeIndex path_next) {
+  const MotionGraph& g = *graph_;
+  const double inv_window = 1.0 / params_.velocity_window;
+  const double vx = p.vx, vy = p.vy;
+  const double keep = params_.lane_change_keep_side;
+  const bool follow_edge = params_.velocity_follows_edge;
+  const double inv_t = 1.0 / std::max(tau, params_.min_jump_dwell);
+  const auto& arc = g.arcs[e];
+  const double ox = arc.ux * arc.length * inv_t, oy = arc.uy * arc.length * inv_t;
+  if (follow_edge) {
+    // Departure from Eq. 7 (velocity_follows_edge): Eq. 7 smooths the speed only; the heading becomes the
+    // edge taken, so a particle that turned (lane end, headland corner) keeps walking the way it turned
+    // instead of pointing back along the lane it left for ~V jumps.
+    const double speed = std::sqrt(vx * vx + vy * vy);
+    const double s = speed + pr * (arc.length * inv_t - speed) * inv_window;
+    p.vx = static_cast<float>(arc.ux * s);
+    p.vy = static_cast<float>(arc.uy * s);
+  } else {
+    p.vx = static_cast<float>(vx + pr * (ox - vx) * inv_window);
+    p.vy = static_cast<float>(vy + pr * (oy - vy) * inv_window);
+  }
+  const NodeIndex from = p.node;
+  p.node = arc.target;
+  p.dwell = 0.0f;
+  if (path_next != topology::kInvalidNode) {
+    // Followed the path (ends one node inside the new lane) or left it.
+    const auto& path = g.lane_paths[p.lane_change - 1];
+    if (arc.target == path_next && path.back() == arc.target) p.last_lane_change = p.lane_change;
+    if (arc.target != path_next || path.back() == arc.target) p.lane_change = 0;
+  } else if (map_->lane(arc.target) != map_->lane(from)) {
+    // Left the lane at an end?
+    p.lane_change = g.exitPathStartingWith(from, arc.target, rng_, p.last_lane_change, keep);
   }
 }
 

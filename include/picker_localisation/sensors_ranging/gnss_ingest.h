@@ -177,6 +177,11 @@ class GnssIngest {
 
  private:
   static constexpr std::size_t kRecentFixes = 10;
+  bool horizontalCovariance(const core::GnssFix& fix, Eigen::Matrix2d& c_en, GnssRejection& rejection,
+                            std::string& why) const;
+  bool passesJumpGate(const Eigen::Vector2d& p, const Eigen::Matrix2d& c_map, double dt, std::string& why);
+  core::Observation observationOf(double stamp, const Eigen::Vector2d& p, const Eigen::Matrix2d& c_map,
+                                  bool* bias_corrected) const;
   struct Accepted {
     double stamp;
     Eigen::Vector2d position;

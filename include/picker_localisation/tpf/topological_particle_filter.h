@@ -201,6 +201,11 @@ class TopologicalParticleFilter {
   void reinitialisePart(const core::Observation& obs, double fraction);
   void redraw(const core::Observation& obs, std::size_t count);  // Eq. 1 for `count` evenly spread particles
   void predict(double dt);
+  void predictFixedLambda(double dt);                    // Khan et al. 2020's fixed-rate motion
+  void reverseSomeVelocities(double dt);                 // mid-lane turns (reverse_rate)
+  void moveWithVelocityModel(std::size_t i, double dt);  // Eqs. 2-7 for particle i
+  topology::NodeIndex projectOnEdges(Particle& p);
+  void jumpAlong(Particle& p, std::uint32_t arc, double pr, double tau, topology::NodeIndex path_next);
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
   bool weightAndResample(const core::Observation& obs, double max_likelihood);  // false: no overlap
