@@ -1,4 +1,4 @@
-// Every shipped config/*.yaml through every reader that uses it (issue "One options schema"): a key renamed in a
+// Every shipped config/*.yaml through every reader that uses it: a key renamed in a
 // reader but not in its file (or the other way round) fails here, in CI, not on the robot. A reader with an
 // unknown-key check must report none for the shipped file; every file must load and validate.
 #include <gtest/gtest.h>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "picker_localisation/core/geodetic_datum.h"
+#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/dispatch/dispatcher_node_options.h"
 #include "picker_localisation/nbs/next_best_sense_planner.h"
@@ -68,7 +69,7 @@ TEST(ConfigFiles, EveryShippedFileLoadsThroughItsReadersWithoutUnknownKeys) {
   EXPECT_NO_THROW(
       dispatch::DispatcherNodeOptions::fromYaml(YAML::LoadFile(use("dispatcher.yaml")), &unknown));
   EXPECT_TRUE(unknown.empty()) << joined(unknown);
-  // No unknown-key check in these readers yet (issue "One options schema"): they must load and validate.
+  // Readers without an unknown-key check of their own: they must load and validate.
   EXPECT_NO_THROW(sim::loadSimConfig(use("sim.yaml")));  // throws on an unknown key itself
   EXPECT_NO_THROW(core::GeodeticDatum::load(use("datum.yaml")));
   EXPECT_NO_THROW(core::PickerRegistry::load(use("pickers.yaml")));
@@ -104,5 +105,47 @@ TEST(ConfigFiles, TpfParamsWarnAboutATypoAndNameTheKey) {
     EXPECT_NE(std::find(tpf::TpfParams::yamlKeys().begin(), tpf::TpfParams::yamlKeys().end(), key),
               tpf::TpfParams::yamlKeys().end())
         << key;
+  }
+}
+
+// The keys every node shares have one name each; the names used before are still read for one release, each
+// with a warning, and a shipped file uses none of them.
+TEST(ConfigFiles, SharedNodeKeysHaveOneNameAndTheOldOnesWarn) {
+  std::vector<std::string> warnings;
+  core::CommonNodeOptions defaults;
+  defaults.tf_timeout = 0.1;
+  const auto o = core::CommonNodeOptions::fromYaml(
+      YAML::Load("{frame_id: odom, observation_topic: /obs, max_future_stamp: 3}"), "gnss_ingest", &warnings,
+      defaults);
+  EXPECT_EQ(o.map_frame, "odom");
+  EXPECT_EQ(o.observations_topic, "/obs");
+  EXPECT_DOUBLE_EQ(o.max_future_stamp, 3.0);
+  EXPECT_DOUBLE_EQ(o.tf_timeout, 0.1);  // the node's own default
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("'frame_id' is deprecated, use 'map_frame'"), std::string::npos) << warnings[0];
+  warnings.clear();
+  // Both names: the new one is used, and the warning says so.
+  const auto both = core::CommonNodeOptions::fromYaml(YAML::Load("{fixed_frame: odom, map_frame: map}"),
+                                                      "leg_detector", &warnings, {});
+  EXPECT_EQ(both.map_frame, "map");
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("both are set"), std::string::npos) << warnings[0];
+  // A bad value names the key; a value of the wrong type too.
+  EXPECT_THROW(core::CommonNodeOptions::fromYaml(YAML::Load("{max_future_stamp: -1}"), "x", nullptr, {}),
+               std::runtime_error);
+  EXPECT_THROW(core::CommonNodeOptions::fromYaml(YAML::Load("{tf_timeout: soon}"), "x", nullptr, {}),
+               std::runtime_error);
+  // No shipped file uses an old name.
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(PL_PACKAGE_DIR) + "/config")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const YAML::Node root = YAML::LoadFile(entry.path().string());
+    std::vector<YAML::Node> maps{root};
+    if (root.IsMap())
+      for (const auto& kv : root)
+        if (kv.second.IsMap()) maps.push_back(kv.second);  // vision.yaml's per-node sections
+    for (const YAML::Node& m : maps)
+      for (const auto& [old_name, name] : core::CommonNodeOptions::deprecatedKeys())
+        EXPECT_FALSE(m.IsMap() && m[old_name])
+            << entry.path() << " uses '" << old_name << "': use '" << name << "'";
   }
 }

@@ -1,5 +1,6 @@
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
+#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/core/yaml_file.h"
 #include "picker_localisation/core/yaml_keys.h"
 
@@ -162,6 +163,7 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::s
   if (unknown && node.IsMap()) {
     std::vector<std::string> known = yamlKeys();
     known.insert(known.end(), nodeKeys().begin(), nodeKeys().end());
+    for (const std::string& k : core::CommonNodeOptions::acceptedKeys()) known.push_back(k);
     for (auto& m : core::unknownKeys(node, known, "nbs config")) unknown->push_back(std::move(m));
     const std::vector<std::pair<const char*, std::vector<std::string>>> sections = {
         {"weights", criterionNames()},

@@ -27,11 +27,11 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
   sensors::GnssIngestOptions o;
   if (!loadOptions(pnh, o)) return;
-  pnh.param<std::string>("frame_id", frame_id_, "map");
-  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
-  double map_timeout = 30.0;
-  pnh.param("map_timeout", map_timeout, map_timeout);
-  map_ = obtainMap(nh, pnh, map_timeout);
+  core::CommonNodeOptions common;
+  if (!loadCommonOptions(pnh, common)) return;
+  frame_id_ = common.map_frame;
+  stamp_guard_ = StampGuard(common.max_future_stamp);
+  map_ = obtainMap(nh, pnh, common.map_timeout);
   if (!map_) return;
   // The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
   // when the map has none.
@@ -55,11 +55,11 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
 
   options_ = o;
   fleet_ = std::make_unique<sensors::GnssFleet>(map_, *datum_, o);
-  std::string topic, person_topic;
-  pnh.param<std::string>("observation_topic", topic, "/observations");
+  const std::string topic = common.observations_topic;
+  std::string person_topic;
   pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
   pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
-  ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.2);
+  ordering_latency_ = orderingLatency(common.ordering_latency, 0.2);
   // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
   on_demand_.start(nh, pnh, registry.size(), [this] { return pickers_.size(); }, [this] {
     for (auto& p : pickers_) advertiseBias(*p);

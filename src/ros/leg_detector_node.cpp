@@ -42,15 +42,19 @@ std::string cloudProblem(const sensor_msgs::PointCloud2& c) {
 
 LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
-  pnh_.param("fixed_frame", fixed_frame_, fixed_frame_);
+  core::CommonNodeOptions common;
+  common.map_frame = fixed_frame_;
+  common.tf_timeout = tf_timeout_;
+  if (!loadCommonOptions(pnh_, common)) return;
+  fixed_frame_ = common.map_frame;
+  tf_timeout_ = common.tf_timeout;
   pnh_.param("robot_id", robot_id_, robot_id_);
-  pnh_.param("tf_timeout", tf_timeout_, tf_timeout_);
   pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
   pnh_.param("max_beams", max_beams_, max_beams_);
   // PCL prints its own unthrottled errors for degenerate clouds (VoxelGrid overflow, RANSAC without a model);
   // malformed clouds are reported here instead, once per throttle period.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
-  stamp_guard_ = StampGuard(pnh_.param("max_future_stamp", 10.0));
+  stamp_guard_ = StampGuard(common.max_future_stamp);
 
   // The pipeline's options: every private parameter through the schema the offline runner uses too.
   vision::LegPipelineOptions options;
@@ -70,9 +74,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   bool publish_observations = true;
   pnh_.param("publish_observations", publish_observations, publish_observations);
   if (publish_observations) {
-    double map_timeout = 30.0;
-    pnh_.param("map_timeout", map_timeout, map_timeout);
-    map_ = obtainMap(nh_, pnh_, map_timeout);
+    map_ = obtainMap(nh_, pnh_, common.map_timeout);
     if (!map_) return;
     // A map edited at run time: the next people are placed on it (nothing kept names a node).
     map_follower_ =
@@ -93,8 +95,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     subs_.push_back(nh_.subscribe(detections_topic, 5, &LegDetectorNode::detectionsCallback, this));
   if (!camera_info_topic.empty())
     subs_.push_back(nh_.subscribe(camera_info_topic, 1, &LegDetectorNode::cameraInfoCallback, this));
-  std::string observations_topic = "/observations";
-  pnh_.param("observations_topic", observations_topic, observations_topic);
+  const std::string observations_topic = common.observations_topic;
   people_pub_ = nh_.advertise<picker_localisation::PersonDetectionArray>("people", 10);
   people_markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("people/markers", 2);
   if (map_) obs_pub_ = nh_.advertise<picker_localisation::Observation>(observations_topic, 50);

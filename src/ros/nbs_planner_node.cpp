@@ -53,11 +53,13 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   std::string ns = ros::this_node::getNamespace();
   while (!ns.empty() && ns.front() == '/') ns.erase(ns.begin());
   pnh_.param<std::string>("robot_id", robot_id_, ns.empty() ? "robot_1" : ns);
-  pnh_.param<std::string>("map_frame", map_frame_, "map");
+  core::CommonNodeOptions common;
+  if (!loadCommonOptions(pnh_, common)) return;
+  map_frame_ = common.map_frame;
+  tf_timeout_ = common.tf_timeout;
   pnh_.param<std::string>("base_frame", base_frame_, robot_id_ + "/base_link");
   pnh_.param("battery_level", battery_level_, 1.0);
   pnh_.param("claim_timeout", claim_timeout_, 30.0);
-  pnh_.param("tf_timeout", tf_timeout_, 0.2);
   pnh_.param("max_pose_age", max_pose_age_, max_pose_age_);
   pnh_.param("use_what_if", use_what_if_, true);
   pnh_.param("what_if_seed", what_if_seed_, 1);

@@ -48,5 +48,18 @@ YAML::Node paramsAsYaml(const ros::NodeHandle& nh) {
   return merged;
 }
 
+bool loadCommonOptions(const ros::NodeHandle& pnh, core::CommonNodeOptions& out) {
+  const std::string name = ros::this_node::getName();
+  try {
+    std::vector<std::string> warnings;
+    out = core::CommonNodeOptions::fromYaml(paramsAsYaml(pnh), name, &warnings, out);
+    for (const auto& w : warnings) ROS_WARN("%s", w.c_str());
+    return true;
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s", e.what());
+    return false;
+  }
+}
+
 }  // namespace ros_adapter
 }  // namespace picker_localisation

@@ -15,12 +15,13 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   // One options schema, shared with the offline runner (config/rfid_ranging.yaml keys).
   sensors::RfidModelOptions o;
   if (!loadOptions(pnh, o)) return;
-  pnh.param<std::string>("map_frame", map_frame_, "map");
-  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
-  pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
-  double map_timeout = 30.0;
-  pnh.param("map_timeout", map_timeout, map_timeout);
-  map_ = obtainMap(nh, pnh, map_timeout);
+  core::CommonNodeOptions common;
+  common.tf_timeout = tf_timeout_;
+  if (!loadCommonOptions(pnh, common)) return;
+  map_frame_ = common.map_frame;
+  stamp_guard_ = StampGuard(common.max_future_stamp);
+  tf_timeout_ = common.tf_timeout;
+  map_ = obtainMap(nh, pnh, common.map_timeout);
   if (!map_) return;
   try {
     model_ = std::make_unique<sensors::RfidObservationModel>(registry, map_, o);
@@ -29,9 +30,7 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     return;
   }
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
-  std::string topic;
-  pnh.param<std::string>("observation_topic", topic, "/observations");
-  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  pub_ = nh.advertise<picker_localisation::Observation>(common.observations_topic, 100);
   const std::vector<std::string> topics = stringListParam(pnh, "rfid_topics", {"rfid"});
   for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
   diagnostics_.setHardwareID("rfid_ranging");

@@ -20,12 +20,15 @@ TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle&
     ROS_FATAL("topological_map_server: parameter ~map_file is required (a tmap2 or legacy tmap file)");
     return;
   }
-  pnh.param<std::string>("frame_id", frame_id, "map");
+  core::CommonNodeOptions common;
+  if (!loadCommonOptions(pnh, common)) return;
+  frame_id = common.map_frame;
   pnh.param("node_scale", node_scale, node_scale);
   pnh.param("labels", labels, labels);
   // Its four keys: a typo is one warning naming the closest, a bad scale one FATAL line (as every node).
-  for (const auto& u : core::unknownKeys(paramsAsYaml(pnh), {"map_file", "frame_id", "node_scale", "labels"},
-                                         "topological_map_server"))
+  for (const auto& u :
+       core::unknownKeys(paramsAsYaml(pnh), {"map_file", "map_frame", "frame_id", "node_scale", "labels"},
+                         "topological_map_server"))
     ROS_WARN("%s", u.c_str());
   if (!(node_scale > 0.0) || !std::isfinite(node_scale)) {
     ROS_FATAL("topological_map_server: %s", core::badValue("node_scale", node_scale, "finite and > 0").c_str());

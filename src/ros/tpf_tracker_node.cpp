@@ -231,10 +231,10 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     base_params_ = tpfYamlFromRos(pnh);
     // The pickers file's and picker_id's keys are this node's, not the filter's.
     for (const char* own :
-         {"pickers_file", "picker_id", "map_file", "tpf_params_file", "seed", "frame_id", "topic_prefix",
-          "observations_topic", "ordering_latency", "max_future_stamp", "on_demand_topics_above",
-          "demand_poll_period", "gnss_ingest", "map_timeout", "map_topic", "current_node_namespace"})
+         {"pickers_file", "picker_id", "tpf_params_file", "seed", "topic_prefix", "on_demand_topics_above",
+          "demand_poll_period", "gnss_ingest", "current_node_namespace"})
       base_params_.remove(own);
+    for (const std::string& shared : core::CommonNodeOptions::acceptedKeys()) base_params_.remove(shared);
     // A bad shared value is one FATAL line, not one per picker; an unknown key (a typo) one warning.
     std::vector<std::string> unknown;
     tpf::TpfParams::fromYaml(base_params_, &unknown);
@@ -243,7 +243,9 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     ROS_FATAL("tpf_tracker: %s", e.what());
     return;
   }
-  pnh.param<std::string>("frame_id", frame_id_, "map");
+  core::CommonNodeOptions common;
+  if (!loadCommonOptions(pnh, common)) return;
+  frame_id_ = common.map_frame;
   pnh.param("seed", seed_param_, 0);
   map_ = obtainMap(nh, pnh);
   if (!map_) return;  // obtainMap logged why
@@ -252,14 +254,13 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
     if (it != tracks_.end()) publish(*it->second);
   });
 
-  std::string observations_topic;
+  const std::string observations_topic = common.observations_topic;
   pnh.param<std::string>("topic_prefix", prefix_, "/pickers");
   // LCAS topological_navigation's coordination reads an agent's node from <agent>/current_node (std_msgs/String):
   // <current_node_namespace>/<id>/current_node, so "/" gives /<id>/current_node; "" publishes none.
   pnh.param<std::string>("current_node_namespace", current_node_ns_, prefix_);
-  pnh.param<std::string>("observations_topic", observations_topic, "/observations");
-  ordering_latency_ = orderingLatency(pnh.param("ordering_latency", -1.0), 0.5);
-  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
+  ordering_latency_ = orderingLatency(common.ordering_latency, 0.5);
+  stamp_guard_ = StampGuard(common.max_future_stamp);
   // Per-picker topics on demand above ~on_demand_topics_above pickers (see advertiseTopics).
   on_demand_.start(nh, pnh, registry_.size(), [this] { return tracks_.size(); }, [this] {
     flush();

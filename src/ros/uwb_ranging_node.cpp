@@ -16,14 +16,16 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   // One options schema, shared with the offline runner (config/uwb_ranging.yaml keys).
   sensors::UwbRangingOptions o;
   if (!loadOptions(pnh, o)) return;
-  pnh.param<std::string>("map_frame", map_frame_, "map");
-  stamp_guard_ = StampGuard(pnh.param("max_future_stamp", 10.0));
+  core::CommonNodeOptions common;
+  common.tf_timeout = tf_timeout_;
+  if (!loadCommonOptions(pnh, common)) return;
+  map_frame_ = common.map_frame;
+  stamp_guard_ = StampGuard(common.max_future_stamp);
+  tf_timeout_ = common.tf_timeout;
   pnh.param<std::string>("base_frame", base_frame_, "");
-  pnh.param("tf_timeout", tf_timeout_, tf_timeout_);
-  double map_timeout = 30.0, flush_period = 0.05;
-  pnh.param("map_timeout", map_timeout, map_timeout);
+  double flush_period = 0.05;
   pnh.param("flush_period", flush_period, flush_period);
-  map_ = obtainMap(nh, pnh, map_timeout);
+  map_ = obtainMap(nh, pnh, common.map_timeout);
   if (!map_) return;
   try {
     uwb_ = std::make_unique<sensors::UwbRanging>(registry, map_, o);
@@ -32,9 +34,7 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     return;
   }
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
-  std::string topic;
-  pnh.param<std::string>("observation_topic", topic, "/observations");
-  pub_ = nh.advertise<picker_localisation::Observation>(topic, 100);
+  pub_ = nh.advertise<picker_localisation::Observation>(common.observations_topic, 100);
   const std::vector<std::string> uwb_topics = stringListParam(pnh, "uwb_topics", {"uwb"});
   const std::vector<std::string> bearing_topics = stringListParam(pnh, "bearing_topics", {});
   for (const std::string& t : uwb_topics) subs_.push_back(nh.subscribe(t, 200, &UwbRangingNode::onRange, this));

@@ -52,6 +52,8 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
                                                  "p_detect",
                                                  "map_frame",
                                                  "observation_topic",
+                                                 "observations_topic",
+                                                 "ordering_latency",
                                                  "rfid_topics",
                                                  "tf_timeout",
                                                  "map_timeout",

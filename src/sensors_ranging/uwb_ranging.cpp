@@ -56,9 +56,9 @@ const std::vector<std::string>& UwbRangingOptions::yamlKeys() {
       "max_range", "batch_window", "bearing_max_age", "pdoa_mode", "pdoa_angle_sigma", "min_sigma",
       "cutoff_sigmas", "reset_after", "max_output_sigma",
       // uwb_ranging node
-      "map_frame", "base_frame", "observation_topic", "max_future_stamp", "uwb_topics", "bearing_topics",
-      "tf_timeout", "map_timeout", "flush_period", "map_file", "pickers_file", "map_topic",
-      "silent_warn_after", "registry_topic", "registry_publisher"};
+      "map_frame", "base_frame", "observation_topic", "observations_topic", "ordering_latency",
+      "max_future_stamp", "uwb_topics", "bearing_topics", "tf_timeout", "map_timeout", "flush_period",
+      "map_file", "pickers_file", "map_topic", "silent_warn_after", "registry_topic", "registry_publisher"};
   return keys;
 }
 

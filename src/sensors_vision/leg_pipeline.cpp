@@ -15,11 +15,24 @@ namespace {
 
 // Keys the leg_detector node reads itself (topics, frames, model, timeouts): valid here, not used here.
 const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {
-      "scan_topics",          "cloud_topic",        "detections_topic", "camera_info_topic", "model_file",
-      "fixed_frame",          "robot_id",           "tf_timeout",       "map_file",          "map_timeout",
-      "publish_observations", "observations_topic", "fusion_max_age",   "map_topic", "max_future_stamp",
-      "max_beams"};
+  static const std::vector<std::string> keys = {"scan_topics",
+                                                "cloud_topic",
+                                                "detections_topic",
+                                                "camera_info_topic",
+                                                "model_file",
+                                                "fixed_frame",
+                                                "robot_id",
+                                                "tf_timeout",
+                                                "map_file",
+                                                "map_timeout",
+                                                "publish_observations",
+                                                "observations_topic",
+                                                "fusion_max_age",
+                                                "map_topic",
+                                                "max_future_stamp",
+                                                "max_beams",
+                                                "map_frame",
+                                                "ordering_latency"};
   return keys;
 }
 const std::vector<std::string>& pipelineKeys() {

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/core/node_options.h"
+
 namespace picker_localisation {
 namespace ros_adapter {
 
@@ -35,6 +37,10 @@ bool loadOptions(const ros::NodeHandle& pnh, Options& out) {
     return false;
   }
 }
+
+// The keys every node shares (core::CommonNodeOptions) from a node's private parameters, over the node's
+// defaults in `out`: one warning per deprecated name; on a bad value one FATAL line naming the key and false.
+bool loadCommonOptions(const ros::NodeHandle& pnh, core::CommonNodeOptions& out);
 
 }  // namespace ros_adapter
 }  // namespace picker_localisation
