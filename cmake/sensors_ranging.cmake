@@ -4,6 +4,7 @@ add_library(picker_localisation_sensors_ranging
   src/sensors_ranging/gnss_bias.cpp
   src/sensors_ranging/gnss_fleet.cpp
   src/sensors_ranging/gnss_ingest.cpp
+  src/sensors_ranging/ranging_node_options.cpp
   src/sensors_ranging/picker_association.cpp
   src/sensors_ranging/rfid_observation_model.cpp
   src/sensors_ranging/range_histogram_filter.cpp

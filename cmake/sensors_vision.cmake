@@ -10,6 +10,7 @@ add_library(picker_localisation_vision
   src/sensors_vision/cluster_tracker.cpp
   src/sensors_vision/lidar_camera_fusion.cpp
   src/sensors_vision/leg_pipeline.cpp
+  src/sensors_vision/leg_detector_node_options.cpp
   src/sensors_vision/cloud3d_person_detector.cpp
   src/sensors_vision/person_box_detector.cpp
   src/sensors_vision/box_evaluation.cpp)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Benchmark (not a ctest): resident memory of one tpf_tracker on a large generated farm (issue "No input may kill a
-# node": per-tracker memory must grow with the map, not its square). Starts a roscore, a tracker on the map, feeds
+# Benchmark (not a ctest): resident memory of one tpf_tracker on a large generated farm (a large map
+# must not stop a node: per-tracker memory must grow with the map, not its square). Starts a roscore, a tracker on the map, feeds
 # it 20 observations, prints one JSON object with the RSS after start-up and after fusing.
 # Usage: scripts/bench_map_memory.sh [LANES=200] [NODES=100] [WORK_DIR]   (200 x 100: 20,400 nodes)
 set -eo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Soak run (a script, not a ctest; issue "No input may kill a node"): the demo graph (launch/demo.launch: farm_sim
+# Soak run (a script, not a ctest): the demo graph (launch/demo.launch: farm_sim
 # with every simulated sensor, gnss_ingest, per robot rfid_ranging / uwb_ranging / leg_detector / nbs_planner,
 # tpf_tracker, evaluator) with PICKERS pickers for DURATION simulated seconds. Every node process's resident memory
 # and CPU time are sampled from /proc every few wall seconds; the last line is one JSON object: per node the RSS after

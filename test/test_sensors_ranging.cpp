@@ -14,6 +14,7 @@
 #include "picker_localisation/sensors_ranging/gnss_ingest.h"
 #include "picker_localisation/sensors_ranging/picker_association.h"
 #include "picker_localisation/sensors_ranging/range_histogram_filter.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
 #include "ranging_test_maps.h"
@@ -822,21 +823,30 @@ TEST(RangeHistogramFilter, SimulatedWalkAccuracyWithAndWithoutCamera) {
 
 // The front-end options schemas shared by the nodes and the offline runner.
 TEST(FrontEndOptions, GnssAndRfidFromYaml) {
+  using picker_localisation::sensors::GnssIngestNodeOptions;
   using picker_localisation::sensors::GnssIngestOptions;
   using picker_localisation::sensors::RfidModelOptions;
   std::vector<std::string> unknown;
-  const GnssIngestOptions g = GnssIngestOptions::fromYaml(
-      YAML::Load("{min_sigma: 2.0, velocity_window: 4, datum_file: x, min_sigm: 1}"), &unknown);
+  // datum_file is the node's key: known to the node's options, not to the algorithm's.
+  const GnssIngestOptions g =
+      GnssIngestNodeOptions::fromYaml(
+          YAML::Load("{min_sigma: 2.0, velocity_window: 4, datum_file: x, min_sigm: 1}"), &unknown)
+          .ingest;
   EXPECT_DOUBLE_EQ(g.min_sigma, 2.0);
   EXPECT_EQ(g.velocity_window, 4u);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].find("did you mean 'min_sigma'"), std::string::npos) << unknown[0];
+  unknown.clear();
+  GnssIngestOptions::fromYaml(YAML::Load("{min_sigma: 2.0, datum_file: x}"), &unknown);
+  ASSERT_EQ(unknown.size(), 1u);  // the algorithm's schema lists no node key
+  EXPECT_NE(unknown[0].find("'datum_file'"), std::string::npos) << unknown[0];
   EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{min_sigma: -1}")), std::runtime_error);
   EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{velocity_window: -2}")), std::runtime_error);
   EXPECT_THROW(GnssIngestOptions::fromYaml(YAML::Load("{max_speed: fast}")), std::runtime_error);
   unknown.clear();
-  const RfidModelOptions r =
-      RfidModelOptions::fromYaml(YAML::Load("{d50: 3.0, rfid_topics: [rfid], pdetect: 1}"), &unknown);
+  const RfidModelOptions r = picker_localisation::sensors::RfidRangingNodeOptions::fromYaml(
+                                 YAML::Load("{d50: 3.0, rfid_topics: [rfid], pdetect: 1}"), &unknown)
+                                 .model;
   EXPECT_DOUBLE_EQ(r.d50, 3.0);
   ASSERT_EQ(unknown.size(), 1u);
   EXPECT_NE(unknown[0].find("'p_detect'"), std::string::npos) << unknown[0];

@@ -9,6 +9,7 @@
 
 #include "picker_localisation/sensors_vision/cluster_tracker.h"
 #include "picker_localisation/sensors_vision/leg_detector.h"
+#include "picker_localisation/sensors_vision/leg_detector_node_options.h"
 #include "picker_localisation/sensors_vision/leg_pipeline.h"
 #include "picker_localisation/sensors_vision/lidar_camera_fusion.h"
 #include "picker_localisation/sensors_vision/munkres.h"
@@ -263,12 +264,15 @@ TEST(Cloud3dPersonDetector, PersonSizedClusterAboveGroundOnly) {
 
 // The leg pipeline's options schema (shared by the leg_detector node and the offline runner).
 TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
+  using picker_localisation::vision::LegDetectorNodeOptions;
   using picker_localisation::vision::LegPipelineOptions;
   std::vector<std::string> unknown;
-  const LegPipelineOptions o = LegPipelineOptions::fromYaml(
-      YAML::Load("{leg_threshold: 0.3, tentative_misses: 2, position_sigma: 0.2, scan_topics: [a], "
-                 "leg_treshold: 0.5, detections_topic: cam}"),
-      &unknown);
+  const LegPipelineOptions o =
+      LegDetectorNodeOptions::fromYaml(
+          YAML::Load("{leg_threshold: 0.3, tentative_misses: 2, position_sigma: 0.2, scan_topics: [a], "
+                     "leg_treshold: 0.5, detections_topic: cam}"),
+          &unknown)
+          .pipeline;
   EXPECT_DOUBLE_EQ(o.detector.leg_threshold, 0.3);
   EXPECT_EQ(o.tracker.tentative_misses, 2);
   EXPECT_DOUBLE_EQ(o.position_sigma, 0.2);

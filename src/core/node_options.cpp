@@ -63,5 +63,13 @@ CommonNodeOptions CommonNodeOptions::fromYaml(const YAML::Node& node, const std:
   return o;
 }
 
+std::string FleetTopicOptions::validate() const {
+  if (on_demand_topics_above < 0) return badValue("on_demand_topics_above", on_demand_topics_above, ">= 0");
+  if (!(demand_poll_period >= 0.2) || !std::isfinite(demand_poll_period))
+    return badValue("demand_poll_period", demand_poll_period, "finite and >= 0.2");
+  if (!(silent_warn_after >= 0.0)) return badValue("silent_warn_after", silent_warn_after, ">= 0 (0: never)");
+  return "";
+}
+
 }  // namespace core
 }  // namespace picker_localisation

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "picker_localisation/core/option_table.h"
 #include "picker_localisation/core/yaml_keys.h"
 
 namespace picker_localisation {
@@ -13,6 +14,42 @@ namespace dispatch {
 
 namespace {
 const char* kComponent = "dispatcher";
+
+const core::OptionTable<DispatcherNodeOptions>& table() {
+  using O = DispatcherNodeOptions;
+  static const core::OptionTable<O> t =
+      core::OptionTable<O>()
+          .add("pickers_file", &O::pickers_file)
+          .add("robots", &O::robots)
+          .add("num_robots", &O::num_robots)
+          .add("map_frame", &O::map_frame)
+          .add("base_frame", &O::base_frame)
+          .add("update_period", &O::update_period)
+          .add("max_pose_age", &O::max_pose_age)
+          .add("goal_topic", &O::goal_topic)
+          .add("goal_pose_topic", &O::goal_pose_topic)
+          .add("goal_node_topic", &O::goal_node_topic)
+          .add("calls_topic", &O::calls_topic)
+          .add("car_topic", &O::car_topic)
+          .add("rfid_topic", &O::rfid_topic)
+          .add("observations_topic", &O::observations_topic)
+          .add("arrival_sensors", &O::arrival_sensors)
+          .add("max_fix_distance", &O::max_fix_distance)
+          .add("forward_fix", &O::forward_fix)
+          .add("row_evidence_floor", &O::row_evidence_floor)
+          .add("closed_calls_kept", &O::closed_calls_kept)
+          .add("calls_log", &O::calls_log)
+          .add("datum_file", &O::datum_file)
+          .add("datum_source", &O::datum_source)
+          .add("belief_topic", &O::fleet, &core::FleetTopicOptions::belief_topic)
+          .add("registry_topic", &O::fleet, &core::FleetTopicOptions::registry_topic)
+          .add("registry_publisher", &O::fleet, &core::FleetTopicOptions::registry_publisher)
+          .add("map_file", &O::map_source, &core::CommonNodeOptions::map_file)
+          .add("map_topic", &O::map_source, &core::CommonNodeOptions::map_topic)
+          .add("map_timeout", &O::map_source, &core::CommonNodeOptions::map_timeout);
+  return t;
+}
+
 }  // namespace
 
 // ---- options
@@ -36,6 +73,7 @@ std::string DispatcherNodeOptions::validate() const {
   if (!(update_period > 0.0) || !std::isfinite(update_period))
     return core::badValue("update_period", update_period, "> 0");
   if (!(max_pose_age >= 0.0)) return core::badValue("max_pose_age", max_pose_age, ">= 0");
+  if (!(map_source.map_timeout >= 0.0)) return core::badValue("map_timeout", map_source.map_timeout, ">= 0");
   if (robots.empty() && num_robots < 1) return core::badValue("num_robots", num_robots, ">= 1");
   for (const std::string& r : robots)
     if (r.empty() || !std::isalpha(static_cast<unsigned char>(r[0])) ||
@@ -52,42 +90,14 @@ std::string DispatcherNodeOptions::validate() const {
 }
 
 const std::vector<std::string>& DispatcherNodeOptions::yamlKeys() {
-  static const std::vector<std::string> keys{
-      "pickers_file", "robots", "num_robots", "map_frame", "base_frame", "update_period", "max_pose_age",
-      "goal_topic", "goal_pose_topic", "goal_node_topic", "calls_topic", "car_topic", "rfid_topic",
-      "observations_topic", "arrival_sensors", "max_fix_distance", "forward_fix", "row_evidence_floor",
-      "closed_calls_kept", "calls_log", "datum_file", "datum_source",
-      // read by the shared helpers (map_source, fleet_topics), documented with them
-      "map_file", "map_topic", "map_timeout", "belief_topic", "registry_topic", "registry_publisher"};
-  return keys;
+  return table().keys();
 }
 
 DispatcherNodeOptions DispatcherNodeOptions::fromYaml(const YAML::Node& node,
                                                       std::vector<std::string>* unknown) {
   DispatcherNodeOptions o;
   const std::string c = kComponent;
-  core::readOption(node, c, "pickers_file", o.pickers_file);
-  core::readOption(node, c, "robots", o.robots);
-  core::readOption(node, c, "num_robots", o.num_robots);
-  core::readOption(node, c, "map_frame", o.map_frame);
-  core::readOption(node, c, "base_frame", o.base_frame);
-  core::readOption(node, c, "update_period", o.update_period);
-  core::readOption(node, c, "max_pose_age", o.max_pose_age);
-  core::readOption(node, c, "goal_topic", o.goal_topic);
-  core::readOption(node, c, "goal_pose_topic", o.goal_pose_topic);
-  core::readOption(node, c, "goal_node_topic", o.goal_node_topic);
-  core::readOption(node, c, "calls_topic", o.calls_topic);
-  core::readOption(node, c, "car_topic", o.car_topic);
-  core::readOption(node, c, "rfid_topic", o.rfid_topic);
-  core::readOption(node, c, "observations_topic", o.observations_topic);
-  core::readOption(node, c, "arrival_sensors", o.arrival_sensors);
-  core::readOption(node, c, "max_fix_distance", o.max_fix_distance);
-  core::readOption(node, c, "forward_fix", o.forward_fix);
-  core::readOption(node, c, "row_evidence_floor", o.row_evidence_floor);
-  core::readOption(node, c, "closed_calls_kept", o.closed_calls_kept);
-  core::readOption(node, c, "calls_log", o.calls_log);
-  core::readOption(node, c, "datum_file", o.datum_file);
-  core::readOption(node, c, "datum_source", o.datum_source);
+  table().read(node, c, o);
   // The dispatcher's own keys (config/dispatcher.yaml) sit in the same namespace.
   YAML::Node core_keys(YAML::NodeType::Map);
   if (node.IsMap())

@@ -1,4 +1,6 @@
 #include "picker_localisation/eval/experiment.h"
+#include "picker_localisation/nbs/nbs_planner_node_options.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 
 #include <algorithm>
 #include <atomic>
@@ -404,14 +406,14 @@ void GraphRun::makePlanner(nbs::Policy policy) {
   // config/nbs.yaml as the nbs_planner node loads it (planner keys, planning_period, battery_level,
   // what_if_seed); the method (or the calls scenario) sets the policy.
   const std::string nbs_file = resolveConfigFile(config_.nbs_config, "nbs.yaml");
-  nbs::PlannerConfig pc =
-      nbs_file.empty() ? nbs::PlannerConfig() : nbs::PlannerConfig::fromYamlFile(nbs_file);
+  nbs::PlannerConfig pc;
   std::uint64_t what_if_seed = 1;
   if (!nbs_file.empty()) {
-    const YAML::Node y = YAML::LoadFile(nbs_file);
-    core::readOption(y, nbs_file, "planning_period", replan_period_);
-    core::readOption(y, nbs_file, "battery_level", battery_level_);
-    core::readOption(y, nbs_file, "what_if_seed", what_if_seed);
+    const nbs::NbsPlannerNodeOptions node = nbs::NbsPlannerNodeOptions::fromYamlFile(nbs_file);
+    pc = node.planner;
+    replan_period_ = node.planning_period;
+    battery_level_ = node.battery_level;
+    what_if_seed = static_cast<std::uint64_t>(std::max(0, node.what_if_seed));
   }
   pc.policy = policy;
   planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, pc);
@@ -873,10 +875,12 @@ void logUnknownKeys(const RunConfig& config, std::ostream& log) {
     }
     for (const std::string& u : unknown) log << "  warning: " << file << ": " << u << "\n";
   };
-  check(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"), sensors::GnssIngestOptions::fromYamlFile);
-  check(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml"), sensors::RfidModelOptions::fromYamlFile);
+  check(resolveConfigFile(config.gnss_config, "gnss_ingest.yaml"),
+        sensors::GnssIngestNodeOptions::fromYamlFile);
+  check(resolveConfigFile(config.rfid_config, "rfid_ranging.yaml"),
+        sensors::RfidRangingNodeOptions::fromYamlFile);
   check(resolveConfigFile(config.tpf_config, "tpf.yaml"), tpf::TpfParams::fromYamlFile);
-  check(resolveConfigFile(config.nbs_config, "nbs.yaml"), nbs::PlannerConfig::fromYamlFile);
+  check(resolveConfigFile(config.nbs_config, "nbs.yaml"), nbs::NbsPlannerNodeOptions::fromYamlFile);
 }
 
 }  // namespace

@@ -1,6 +1,5 @@
 #include "picker_localisation/nbs/next_best_sense_planner.h"
 
-#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/core/yaml_file.h"
 #include "picker_localisation/core/yaml_keys.h"
 
@@ -147,33 +146,29 @@ const std::vector<std::string>& PlannerConfig::yamlKeys() {
   return keys;
 }
 
-const std::vector<std::string>& PlannerConfig::nodeKeys() {
-  static const std::vector<std::string> keys = {
-      "robot_id",           "map_frame",      "base_frame",  "battery_level", "claim_timeout",
-      "tf_timeout",         "max_pose_age",   "use_what_if", "what_if_seed",  "planning_period",
-      "pickers_file",       "fleet",          "num_robots",  "battery_topic", "goal_pose_topic",
-      "map_file",           "map_topic",      "map_timeout", "belief_topic",  "registry_topic",
-      "registry_publisher", "call_goal_topic"};
-  return keys;
+std::vector<std::string> PlannerConfig::unknownKeys(const YAML::Node& node,
+                                                    const std::vector<std::string>& also_known) {
+  std::vector<std::string> out;
+  if (!node || !node.IsMap()) return out;
+  std::vector<std::string> known = yamlKeys();
+  known.insert(known.end(), also_known.begin(), also_known.end());
+  for (auto& m : core::unknownKeys(node, known, "nbs config")) out.push_back(std::move(m));
+  const std::vector<std::pair<const char*, std::vector<std::string>>> sections = {
+      {"weights", criterionNames()},
+      {"rfid", {"read_range", "p_detect", "min_sensing_time", "max_sensing_time"}},
+      {"energy", {"capacity", "drive_energy_per_m", "base_power", "sensing_power", "speed", "reserve"}}};
+  for (const auto& [section, keys] : sections)
+    if (node[section])
+      for (auto& m : core::unknownKeys(node[section], keys, std::string("nbs config: ") + section))
+        out.push_back(std::move(m));
+  return out;
 }
 
 PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::string>* unknown) {
   PlannerConfig c;
   if (!node) return c;
-  if (unknown && node.IsMap()) {
-    std::vector<std::string> known = yamlKeys();
-    known.insert(known.end(), nodeKeys().begin(), nodeKeys().end());
-    for (const std::string& k : core::CommonNodeOptions::acceptedKeys()) known.push_back(k);
-    for (auto& m : core::unknownKeys(node, known, "nbs config")) unknown->push_back(std::move(m));
-    const std::vector<std::pair<const char*, std::vector<std::string>>> sections = {
-        {"weights", criterionNames()},
-        {"rfid", {"read_range", "p_detect", "min_sensing_time", "max_sensing_time"}},
-        {"energy", {"capacity", "drive_energy_per_m", "base_power", "sensing_power", "speed", "reserve"}}};
-    for (const auto& [section, keys] : sections)
-      if (node[section])
-        for (auto& m : core::unknownKeys(node[section], keys, std::string("nbs config: ") + section))
-          unknown->push_back(std::move(m));
-  }
+  if (unknown)
+    for (auto& m : unknownKeys(node, {})) unknown->push_back(std::move(m));
   if (node["policy"]) {
     try {
       c.policy = policyFromString(node["policy"].as<std::string>());

@@ -55,7 +55,7 @@ DispatcherNode::DispatcherNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     ROS_FATAL("%s: %s", name.c_str(), e.what());
     return;
   }
-  map_ = obtainMap(nh_, pnh_);
+  map_ = obtainMap(nh_, options_.map_source);
   if (!map_) return;
   // The datum places a call's fix on the map (as gnss_ingest does); without one, fixes are left out.
   try {
@@ -74,15 +74,16 @@ DispatcherNode::DispatcherNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     return;
   }
   map_follower_ = std::make_unique<MapFollower>(
-      nh_, pnh_, map_,
+      nh_, options_.map_source, map_,
       [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& change) {
         adoptMap(std::move(m), change);
       });
 
   beliefs_ = std::make_unique<FleetBeliefs>(
-      nh_, pnh_, [this](const picker_localisation::PickerBelief& b) { beliefCallback(b); });
+      nh_, options_.fleet.belief_topic,
+      [this](const picker_localisation::PickerBelief& b) { beliefCallback(b); });
   beliefs_->follow(registry_.ids());
-  registry_sub_ = followPickerList(nh_, pnh_, name.c_str(), [this](const core::PickerRegistry& r) {
+  registry_sub_ = followPickerList(nh_, options_.fleet, name.c_str(), [this](const core::PickerRegistry& r) {
     registry_ = r;
     beliefs_->follow(r.ids());
   });

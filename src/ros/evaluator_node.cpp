@@ -26,10 +26,12 @@ EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "ordering_latency", o.ordering_latency);
   core::readOption(y, c, "max_truth_distance", o.max_truth_distance);
   core::readOption(y, c, "max_future_stamp", o.max_future_stamp);
-  static const std::vector<std::string> known{"pickers_file",     "sample_rate",      "duration",
-                                              "output_csv",       "ordering_latency", "max_truth_distance",
-                                              "max_future_stamp", "map_file",         "map_topic",
-                                              "belief_topic",     "registry_topic",   "registry_publisher"};
+  core::readOption(y, c, "belief_topic", o.belief_topic);
+  core::readOption(y, c, "map_file", o.map_file);
+  core::readOption(y, c, "map_topic", o.map_topic);
+  static const std::vector<std::string> known{
+      "pickers_file",       "sample_rate",      "duration", "output_csv", "ordering_latency",
+      "max_truth_distance", "max_future_stamp", "map_file", "map_topic",  "belief_topic"};
   return core::checkOptions(o, y, known, c, unknown);
 }
 
@@ -64,7 +66,10 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
     ROS_FATAL("evaluator: %s", e.what());
     return;
   }
-  map_ = obtainMap(nh, pnh);
+  core::CommonNodeOptions map_source;
+  map_source.map_file = o.map_file;
+  map_source.map_topic = o.map_topic;
+  map_ = obtainMap(nh, map_source);
   if (!map_) return;
   pickers_.resize(registry.size());
   for (std::size_t i = 0; i < registry.size(); ++i) {
@@ -77,7 +82,8 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
         [this, i](const geometry_msgs::PoseStamped::ConstPtr& m) { onTruth(i, m); });
     p.error_pub = nh.advertise<picker_localisation::TrackingError>(base + "/error", 10);
   }
-  beliefs_ = std::make_unique<FleetBeliefs>(nh, pnh, [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
+  beliefs_ = std::make_unique<FleetBeliefs>(
+      nh, o.belief_topic, [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
   beliefs_->follow(registry.ids());
   diagnostics_.setHardwareID("evaluator");
   diagnostics_.add("evaluator", this, &Evaluator::diagnose);
@@ -87,7 +93,8 @@ Evaluator::Evaluator(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   // A map edited at run time: errors are measured on it from now on; the samples taken before name the node
   // each of theirs maps to on the new map (the same name, else the nearest), so the CSV uses one map.
   map_follower_ = std::make_unique<MapFollower>(
-      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& c) {
+      nh, map_source, map_,
+      [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& c) {
         for (Picker& p : pickers_)
           for (eval::ErrorSample& s : p.samples) {
             s.estimated_node = c.old_to_new.at(s.estimated_node);

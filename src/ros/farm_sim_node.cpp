@@ -136,6 +136,7 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
                                               "map_frame",
                                               "map_file",
                                               "map_topic",
+                                              "map_timeout",
                                               "calls",
                                               "tray_time_mean",
                                               "calls_topic",
@@ -203,7 +204,9 @@ FarmSimNode::FarmSimNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), p
   map_frame_ = o.map_frame;
   const std::string& datum_source = o.datum_source;
 
-  map_ = obtainMap(nh_, pnh_);
+  const std::optional<core::CommonNodeOptions> map_source = mapOptionsOf(pnh_);
+  if (!map_source) return;
+  map_ = obtainMap(nh_, *map_source);
   if (!map_) return;
   try {
     if (useMapDatum(datum_source, *map_)) {  // the rule gnss_ingest follows, so both use one datum

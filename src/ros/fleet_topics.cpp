@@ -23,14 +23,13 @@ std::string gnssTopicProblem(const std::string& topic) {
   return "";
 }
 
-ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, const char* node,
+ros::Subscriber followPickerList(ros::NodeHandle& nh, const core::FleetTopicOptions& fleet, const char* node,
                                  std::function<void(const core::PickerRegistry&)> apply) {
-  std::string topic, publisher;
-  pnh.param<std::string>("registry_topic", topic, "/pickers/registry");
+  const std::string topic = fleet.registry_topic;
   if (topic.empty()) return ros::Subscriber();
   // Only the tracker's list: any node may publish on the topic, and one empty list from a stranger would drop
   // every picker's GNSS subscription.
-  pnh.param<std::string>("registry_publisher", publisher, "/tpf_tracker");
+  std::string publisher = fleet.registry_publisher;
   if (!publisher.empty()) publisher = ros::names::resolve(publisher);
   const std::string name = node;
   // One warning per foreign publisher (at most 100 named): each stranger is named once, none floods the log.
@@ -63,9 +62,8 @@ ros::Subscriber followPickerList(ros::NodeHandle& nh, ros::NodeHandle& pnh, cons
           }));
 }
 
-FleetBeliefs::FleetBeliefs(ros::NodeHandle& nh, ros::NodeHandle& pnh, Callback on_belief)
-    : nh_(nh), on_belief_(std::move(on_belief)) {
-  pnh.param<std::string>("belief_topic", topic_, "/pickers/beliefs");
+FleetBeliefs::FleetBeliefs(ros::NodeHandle& nh, const std::string& topic, Callback on_belief)
+    : nh_(nh), topic_(topic), on_belief_(std::move(on_belief)) {
   if (topic_.empty()) return;
   fleet_ = nh_.subscribe<picker_localisation::PickerBeliefArray>(
       topic_, 100, [this](const picker_localisation::PickerBeliefArray::ConstPtr& m) {

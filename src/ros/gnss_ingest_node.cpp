@@ -9,95 +9,58 @@
 
 #include <picker_localisation/GnssBias.h>
 
+#include "picker_localisation/ros/gnss_ingest_node.h"
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
-#include "picker_localisation/ros/gnss_ingest_node.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
 GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh) {
-  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "gnss_ingest");
+  // The node's options; the algorithm's (config/gnss_ingest.yaml) are the struct the offline runner builds.
+  sensors::GnssIngestNodeOptions node_options;
+  if (!loadOptions(pnh, node_options)) return;
+  const sensors::GnssIngestOptions& o = node_options.ingest;
+  const core::CommonNodeOptions& common = node_options.common;
+  const std::optional<core::PickerRegistry> registry_opt =
+      loadPickerRegistry(node_options.fleet.pickers_file, "gnss_ingest");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  pnh.param<std::string>("datum_file", datum_file_, "");
-  pnh.param<std::string>("datum_source", datum_source_, "auto");
-  // One options schema, shared with the offline runner (config/gnss_ingest.yaml keys).
-  sensors::GnssIngestOptions o;
-  if (!loadOptions(pnh, o)) return;
-  core::CommonNodeOptions common;
-  if (!loadCommonOptions(pnh, common)) return;
+  datum_file_ = node_options.datum_file;
+  datum_source_ = node_options.datum_source;
   frame_id_ = common.map_frame;
   stamp_guard_ = StampGuard(common.max_future_stamp);
-  map_ = obtainMap(nh, pnh, common.map_timeout);
+  map_ = obtainMap(nh, common);
   if (!map_) return;
-  // The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
-  // when the map has none.
-  try {
-    if (useMapDatum(datum_source_, *map_)) {
-      const core::DatumConfig c = map_->datum()->config();
-      datum_ = std::make_unique<core::GeodeticDatum>(c);
-      ROS_INFO("gnss_ingest: datum from the map (%.7f, %.7f, %.1f m; ~datum_source file uses %s instead)",
-               c.latitude, c.longitude, c.altitude, datum_file_.empty() ? "~datum_file" : datum_file_.c_str());
-    } else {
-      if (datum_file_.empty())
-        throw std::runtime_error("parameter ~datum_file (config/datum.yaml) is required: the map has no datum");
-      datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file_));
-      ROS_INFO("gnss_ingest: datum from %s%s", datum_file_.c_str(),
-               map_->datum() ? " (~datum_source file: the map's own datum is not used)" : "");
-    }
-  } catch (const std::exception& e) {
-    ROS_FATAL("gnss_ingest: %s", e.what());
-    return;
-  }
+  if (!loadDatum()) return;
 
   options_ = o;
   fleet_ = std::make_unique<sensors::GnssFleet>(map_, *datum_, o);
   const std::string topic = common.observations_topic;
-  std::string person_topic;
-  pnh.param<std::string>("person_observation_topic", person_topic, "/person_observations");
-  pnh.param<std::string>("bias_topic_prefix", bias_prefix_, "/pickers");
+  bias_prefix_ = node_options.bias_topic_prefix;
   ordering_latency_ = orderingLatency(common.ordering_latency, 0.2);
   // As tpf_tracker: above ~on_demand_topics_above pickers a bias topic exists while someone subscribes.
-  on_demand_.start(nh, pnh, registry.size(), [this] { return pickers_.size(); }, [this] {
-    for (auto& p : pickers_) advertiseBias(*p);
-  });
+  on_demand_.start(
+      nh, node_options.fleet, registry.size(), [this] { return pickers_.size(); },
+      [this] {
+        for (auto& p : pickers_) advertiseBias(*p);
+      });
   ordering_ = core::StampOrderedBuffer<Input>(ordering_latency_, 10000 + 20 * registry.size());
   pub_ = nh.advertise<picker_localisation::Observation>(topic, 1000);
   markers_pub_ = CountedPublisher::advertise<visualization_msgs::MarkerArray>(pnh, "bias_markers", 2, {}, true);
   for (const core::PickerConfig& p : registry.pickers()) addPicker(p);
   if (o.association.enabled && o.association.belief_weight > 0.0) {
-    beliefs_ = std::make_unique<FleetBeliefs>(nh, pnh, [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
+    beliefs_ =
+        std::make_unique<FleetBeliefs>(nh, node_options.fleet.belief_topic,
+                                       [this](const picker_localisation::PickerBelief& b) { onBelief(b); });
     beliefs_->follow(registry.ids());
   }
-  subs_.push_back(followPickerList(nh, pnh, "gnss_ingest", [this](const core::PickerRegistry& r) { onRegistry(r); }));
-  if (!person_topic.empty()) {  // with associate_people false the people are passed on unchanged
-    subs_.push_back(nh.subscribe<picker_localisation::Observation>(
-        person_topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
-    ROS_INFO("gnss_ingest: %s anonymous people from %s", o.association.enabled ? "associating" : "passing on",
-             person_topic.c_str());
-  }
-  // Other people detectors and map-frame picker positions (issue "Drop-in on an LCAS robot").
-  pnh.param<std::string>("people_pose_sensor", people_pose_sensor_, people_pose_sensor_);
-  pnh.param("people_pose_sigma", people_pose_sigma_, people_pose_sigma_);
-  pnh.param<std::string>("pose_sensor", pose_sensor_, pose_sensor_);
-  pnh.param<std::string>("pose_topic_format", pose_topic_format_, "");
-  int max_people = static_cast<int>(max_people_per_message_);
-  pnh.param("max_people_per_message", max_people, max_people);
-  if (!(people_pose_sigma_ > 0.0) || !std::isfinite(people_pose_sigma_) || people_pose_sensor_.empty() ||
-      pose_sensor_.empty() || max_people < 1) {
-    ROS_FATAL(
-        "gnss_ingest: people_pose_sigma and max_people_per_message must be > 0 and people_pose_sensor / "
-        "pose_sensor non-empty");
-    return;
-  }
-  max_people_per_message_ = static_cast<std::size_t>(max_people);
-  for (const std::string& t : stringListParam(pnh, "people_pose_topics", {}))
-    subs_.push_back(nh.subscribe<geometry_msgs::PoseArray>(
-        t, 20, [this, t](const geometry_msgs::PoseArray::ConstPtr& m) { onPeoplePoses(m, t); }));
-  followPoseTopics(registry.ids());
+  subs_.push_back(followPickerList(nh, node_options.fleet, "gnss_ingest",
+                                   [this](const core::PickerRegistry& r) { onRegistry(r); }));
+  subscribePeople(nh, node_options, registry);
   if (!o.bias.sighting_sensors.empty() || (o.association.enabled && !o.association.identity_sensors.empty()))
     subs_.push_back(nh.subscribe<picker_localisation::Observation>(
         topic, 200, [this](const picker_localisation::Observation::ConstPtr& m) { onIdentified(m); }));
@@ -108,15 +71,64 @@ GnssIngestNode::GnssIngestNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(
   ROS_INFO("gnss_ingest: %zu picker(s) with GNSS, ordering latency %.2f s (%s)", pickers_.size(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "processed on arrival");
   diagnostics_.setHardwareID("gnss_ingest");
-  silence_.configure(pnh, "GNSS fixes");
+  silence_.configure(node_options.fleet.silent_warn_after, "GNSS fixes");
   diagnostics_.add("GNSS ingestion", this, &GnssIngestNode::diagnose);
   for (const char* input : {"fixes", "people", "identifying observations", "beliefs"}) diagnostics_.input(input);
   diagnostics_.start(nh);
-  map_follower_ = std::make_unique<MapFollower>(
-      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange& c) {
-        adoptMap(std::move(m), c);
-      });
+  map_follower_ =
+      std::make_unique<MapFollower>(nh, common, map_,
+                                    [this](std::shared_ptr<const topology::TopologicalMap> m,
+                                           const topology::MapChange& c) { adoptMap(std::move(m), c); });
   ok_ = true;
+}
+
+// The datum: the map's own (tmap2 meta.datum_*, LCAS add_datum) unless ~datum_source says file; the file's
+// when the map has none. False after one FATAL line.
+bool GnssIngestNode::loadDatum() {
+  try {
+    if (useMapDatum(datum_source_, *map_)) {
+      const core::DatumConfig c = map_->datum()->config();
+      datum_ = std::make_unique<core::GeodeticDatum>(c);
+      ROS_INFO("gnss_ingest: datum from the map (%.7f, %.7f, %.1f m; ~datum_source file uses %s instead)",
+               c.latitude, c.longitude, c.altitude,
+               datum_file_.empty() ? "~datum_file" : datum_file_.c_str());
+    } else {
+      if (datum_file_.empty())
+        throw std::runtime_error(
+            "parameter ~datum_file (config/datum.yaml) is required: the map has no datum");
+      datum_ = std::make_unique<core::GeodeticDatum>(core::GeodeticDatum::load(datum_file_));
+      ROS_INFO("gnss_ingest: datum from %s%s", datum_file_.c_str(),
+               map_->datum() ? " (~datum_source file: the map's own datum is not used)" : "");
+    }
+  } catch (const std::exception& e) {
+    ROS_FATAL("gnss_ingest: %s", e.what());
+    return false;
+  }
+  return true;
+}
+
+// Anonymous people to associate (leg_detector's), other detectors' people and the pickers' own map-frame
+// positions (an LCAS robot's people and pickers' poses).
+void GnssIngestNode::subscribePeople(ros::NodeHandle& nh, const sensors::GnssIngestNodeOptions& node_options,
+                                     const core::PickerRegistry& registry) {
+  if (!node_options.person_observation_topic
+           .empty()) {  // with associate_people false the people are passed on unchanged
+    subs_.push_back(nh.subscribe<picker_localisation::Observation>(
+        node_options.person_observation_topic, 200,
+        [this](const picker_localisation::Observation::ConstPtr& m) { onPerson(m); }));
+    ROS_INFO("gnss_ingest: %s anonymous people from %s",
+             options_.association.enabled ? "associating" : "passing on",
+             node_options.person_observation_topic.c_str());
+  }
+  people_pose_sensor_ = node_options.people_pose_sensor;
+  people_pose_sigma_ = node_options.people_pose_sigma;
+  pose_sensor_ = node_options.pose_sensor;
+  pose_topic_format_ = node_options.pose_topic_format;
+  max_people_per_message_ = static_cast<std::size_t>(node_options.max_people_per_message);
+  for (const std::string& t : node_options.people_pose_topics)
+    subs_.push_back(nh.subscribe<geometry_msgs::PoseArray>(
+        t, 20, [this, t](const geometry_msgs::PoseArray::ConstPtr& m) { onPeoplePoses(m, t); }));
+  followPoseTopics(registry.ids());
 }
 
 void GnssIngestNode::adoptMap(std::shared_ptr<const topology::TopologicalMap> map,

@@ -45,10 +45,10 @@ void TopicDemand::run() {
   }
 }
 
-void OnDemandTopics::start(ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::size_t expected,
+void OnDemandTopics::start(ros::NodeHandle& nh, const core::FleetTopicOptions& fleet, std::size_t expected,
                            std::function<std::size_t()> pickers, std::function<void()> sweep) {
-  above_ = static_cast<std::size_t>(std::max(0, pnh.param("on_demand_topics_above", 100)));
-  period_ = std::max(0.2, pnh.param("demand_poll_period", 2.0));
+  above_ = static_cast<std::size_t>(std::max(0, fleet.on_demand_topics_above));
+  period_ = std::max(0.2, fleet.demand_poll_period);
   pickers_ = std::move(pickers);
   sweep_ = std::move(sweep);
   if (expected > above_) demand_ = std::make_unique<TopicDemand>(period_);

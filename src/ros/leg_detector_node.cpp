@@ -1,4 +1,5 @@
 #include "picker_localisation/ros/leg_detector_node.h"
+#include "picker_localisation/sensors_vision/leg_detector_node_options.h"
 
 #include <pcl/console/print.h>
 #include <pcl_conversions/pcl_conversions.h>
@@ -42,26 +43,23 @@ std::string cloudProblem(const sensor_msgs::PointCloud2& c) {
 
 LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_), diagnostics_(nh, pnh) {
-  core::CommonNodeOptions common;
-  common.map_frame = fixed_frame_;
-  common.tf_timeout = tf_timeout_;
-  if (!loadCommonOptions(pnh_, common)) return;
+  // The node's options; the pipeline's (config/vision.yaml) are the struct the offline runner builds.
+  vision::LegDetectorNodeOptions o;
+  if (!loadOptions(pnh_, o)) return;
+  const core::CommonNodeOptions& common = o.common;
   fixed_frame_ = common.map_frame;
   tf_timeout_ = common.tf_timeout;
-  pnh_.param("robot_id", robot_id_, robot_id_);
-  pnh_.param("fusion_max_age", fusion_max_age_, fusion_max_age_);
-  pnh_.param("max_beams", max_beams_, max_beams_);
+  robot_id_ = o.robot_id;
+  fusion_max_age_ = o.fusion_max_age;
+  max_beams_ = o.max_beams;
   // PCL prints its own unthrottled errors for degenerate clouds (VoxelGrid overflow, RANSAC without a model);
   // malformed clouds are reported here instead, once per throttle period.
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
   stamp_guard_ = StampGuard(common.max_future_stamp);
 
-  // The pipeline's options: every private parameter through the schema the offline runner uses too.
-  vision::LegPipelineOptions options;
-  if (!loadOptions(pnh_, options)) return;
-  const std::string default_model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
-  std::string model = pnh_.param("model_file", default_model);
-  if (model.empty()) model = default_model;  // config/vision.yaml documents "" as the shipped model
+  const vision::LegPipelineOptions& options = o.pipeline;
+  std::string model = o.model_file;  // config/vision.yaml documents "" as the shipped model
+  if (model.empty()) model = ros::package::getPath("picker_localisation") + "/config/leg_classifier.yml";
   try {
     auto classifier = std::make_shared<vision::LegClassifier>();
     classifier->load(model);
@@ -71,25 +69,20 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     return;
   }
 
-  bool publish_observations = true;
-  pnh_.param("publish_observations", publish_observations, publish_observations);
-  if (publish_observations) {
-    map_ = obtainMap(nh_, pnh_, common.map_timeout);
+  if (o.publish_observations) {
+    map_ = obtainMap(nh_, common);
     if (!map_) return;
     // A map edited at run time: the next people are placed on it (nothing kept names a node).
     map_follower_ =
-        std::make_unique<MapFollower>(nh_, pnh_, map_,
+        std::make_unique<MapFollower>(nh_, common, map_,
                                       [this](std::shared_ptr<const topology::TopologicalMap> m,
                                              const topology::MapChange&) { map_ = std::move(m); });
   }
 
-  std::vector<std::string> scan_topics{"scan"};
-  pnh_.param("scan_topics", scan_topics, scan_topics);
-  for (const auto& t : scan_topics) subs_.push_back(nh_.subscribe(t, 10, &LegDetectorNode::scanCallback, this));
-  std::string cloud_topic, detections_topic, camera_info_topic;
-  pnh_.param("cloud_topic", cloud_topic, cloud_topic);
-  pnh_.param("detections_topic", detections_topic, detections_topic);
-  pnh_.param("camera_info_topic", camera_info_topic, camera_info_topic);
+  for (const auto& t : o.scan_topics)
+    subs_.push_back(nh_.subscribe(t, 10, &LegDetectorNode::scanCallback, this));
+  const std::string &cloud_topic = o.cloud_topic, &detections_topic = o.detections_topic,
+                    &camera_info_topic = o.camera_info_topic;
   if (!cloud_topic.empty()) subs_.push_back(nh_.subscribe(cloud_topic, 2, &LegDetectorNode::cloudCallback, this));
   if (!detections_topic.empty())
     subs_.push_back(nh_.subscribe(detections_topic, 5, &LegDetectorNode::detectionsCallback, this));
@@ -106,7 +99,7 @@ LegDetectorNode::LegDetectorNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   diagnostics_.start(nh_);
   ok_ = true;
   ROS_INFO("%s: %zu scan topic(s), model %s, fixed frame %s%s", ros::this_node::getName().c_str(),
-           scan_topics.size(), model.c_str(), fixed_frame_.c_str(),
+           o.scan_topics.size(), model.c_str(), fixed_frame_.c_str(),
            detections_topic.empty() ? "" : ", camera fusion on");
 }
 

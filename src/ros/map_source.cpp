@@ -10,15 +10,36 @@
 #include <stdexcept>
 
 #include "picker_localisation/ros/map_conversions.h"
+#include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/topology/map_io.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
-std::string mapTopic(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  std::string topic;
-  if (!pnh.getParam("map_topic", topic) || topic.empty()) nh.getParam("/map_topic", topic);
+namespace {
+
+// A node's map_file / map_topic, else the global /map_file, /map_topic (one setting a launch file gives every
+// node): the only parameters read outside a node's options struct, as they are not the node's.
+std::string ownOrGlobal(const std::string& own, const char* global) {
+  std::string value = own;
+  if (value.empty()) ros::param::get(global, value);
+  return value;
+}
+
+}  // namespace
+
+std::string mapTopic(ros::NodeHandle& nh, const core::CommonNodeOptions& common) {
+  const std::string topic = ownOrGlobal(common.map_topic, "/map_topic");
   return nh.resolveName(topic.empty() ? std::string(kMapTopic) : topic);
+}
+
+std::optional<core::CommonNodeOptions> mapOptionsOf(const ros::NodeHandle& pnh) {
+  try {
+    return core::CommonNodeOptions::fromYaml(paramsAsYaml(pnh), ros::this_node::getName(), nullptr, {});
+  } catch (const std::exception& e) {
+    ROS_FATAL("%s", e.what());
+    return std::nullopt;
+  }
 }
 
 bool useMapDatum(const std::string& datum_source, const topology::TopologicalMap& map) {
@@ -158,14 +179,14 @@ std::shared_ptr<const topology::TopologicalMap> takeMap(const std::string& topic
 
 }  // namespace
 
-std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, ros::NodeHandle& pnh,
-                                                          double timeout) {
+std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh,
+                                                          const core::CommonNodeOptions& common) {
   const std::string name = ros::this_node::getName();
-  std::string map_file;
-  if (!pnh.getParam("map_file", map_file)) nh.getParam("/map_file", map_file);
+  const double timeout = common.map_timeout;
+  const std::string map_file = ownOrGlobal(common.map_file, "/map_file");
   try {
     if (!map_file.empty()) return std::make_shared<topology::TopologicalMap>(topology::loadMap(map_file));
-    const std::string topic = mapTopic(nh, pnh);
+    const std::string topic = mapTopic(nh, common);
     ROS_INFO("%s: waiting for the topological map on %s", name.c_str(), topic.c_str());
     MapRefusals refusals(nh, name, topic);
     ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout > 0 ? timeout : 1e9);
@@ -247,12 +268,10 @@ struct MapFollower::Impl {
   std::size_t updates = 0;
 };
 
-MapFollower::MapFollower(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+MapFollower::MapFollower(ros::NodeHandle& nh, const core::CommonNodeOptions& common,
                          std::shared_ptr<const topology::TopologicalMap> current, Adopt adopt) {
-  std::string map_file;
-  if (!pnh.getParam("map_file", map_file)) nh.getParam("/map_file", map_file);
-  if (!map_file.empty() || !current) return;
-  const std::string topic = mapTopic(nh, pnh);
+  if (!ownOrGlobal(common.map_file, "/map_file").empty() || !current) return;
+  const std::string topic = mapTopic(nh, common);
   impl_ = std::make_unique<Impl>(nh, ros::this_node::getName(), topic);
   impl_->current = std::move(current);
   impl_->adopt = std::move(adopt);

@@ -1,4 +1,5 @@
 #include "picker_localisation/ros/nbs_planner_node.h"
+#include "picker_localisation/nbs/nbs_planner_node_options.h"
 
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -35,59 +36,32 @@ std_msgs::ColorRGBA utilityColour(double u) {
 
 }  // namespace
 
-nbs::PlannerConfig plannerConfigFromParams(const ros::NodeHandle& pnh) {
-  XmlRpc::XmlRpcValue all;
-  if (!ros::param::get(pnh.getNamespace(), all) || all.getType() != XmlRpc::XmlRpcValue::TypeStruct)
-    return nbs::PlannerConfig();
-  YAML::Node node = toYaml(all);
-  // Integer-valued doubles given as ints (e.g. horizon_m: 20) convert fine through YAML scalars.
-  std::vector<std::string> unknown;
-  nbs::PlannerConfig config = nbs::PlannerConfig::fromYaml(node, &unknown);
-  for (const std::string& u : unknown) ROS_WARN("%s: %s", ros::this_node::getName().c_str(), u.c_str());
-  return config;
-}
-
 NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_) {
   const std::string name = ros::this_node::getName();
-  std::string ns = ros::this_node::getNamespace();
-  while (!ns.empty() && ns.front() == '/') ns.erase(ns.begin());
-  pnh_.param<std::string>("robot_id", robot_id_, ns.empty() ? "robot_1" : ns);
-  core::CommonNodeOptions common;
-  if (!loadCommonOptions(pnh_, common)) return;
-  map_frame_ = common.map_frame;
-  tf_timeout_ = common.tf_timeout;
-  pnh_.param<std::string>("base_frame", base_frame_, robot_id_ + "/base_link");
-  pnh_.param("battery_level", battery_level_, 1.0);
-  pnh_.param("claim_timeout", claim_timeout_, 30.0);
-  pnh_.param("max_pose_age", max_pose_age_, max_pose_age_);
-  pnh_.param("use_what_if", use_what_if_, true);
-  pnh_.param("what_if_seed", what_if_seed_, 1);
-  double period = 5.0;
-  pnh_.param("planning_period", period, 5.0);
-  std::string pickers_file;
-  pnh_.param<std::string>("pickers_file", pickers_file, "");
-  if (!(period > 0.0) || !(claim_timeout_ > 0.0) || !(battery_level_ >= 0.0 && battery_level_ <= 1.0)) {
-    ROS_FATAL("%s: planning_period and claim_timeout must be > 0 and battery_level in [0, 1]", name.c_str());
-    return;
-  }
-
-  nbs::PlannerConfig config;
-  try {
-    config = plannerConfigFromParams(pnh_);
-  } catch (const std::exception& e) {
-    ROS_FATAL("%s: %s", name.c_str(), e.what());
-    return;
-  }
+  nbs::NbsPlannerNodeOptions o;
+  if (!loadOptions(pnh_, o)) return;
+  const nbs::PlannerConfig& config = o.planner;
+  robot_id_ = o.robotId(ros::this_node::getNamespace());
+  map_frame_ = o.common.map_frame;
+  tf_timeout_ = o.common.tf_timeout;
+  base_frame_ = o.baseFrame(robot_id_);
+  battery_level_ = o.battery_level;
+  claim_timeout_ = o.claim_timeout;
+  max_pose_age_ = o.max_pose_age;
+  use_what_if_ = o.use_what_if;
+  what_if_seed_ = o.what_if_seed;
+  const double period = o.planning_period;
   core::PickerRegistry registry;
   try {
-    if (pickers_file.empty()) throw std::runtime_error("~pickers_file is not set (config/pickers.yaml)");
-    registry = core::PickerRegistry::load(pickers_file);
+    if (o.fleet.pickers_file.empty())
+      throw std::runtime_error("~pickers_file is not set (config/pickers.yaml)");
+    registry = core::PickerRegistry::load(o.fleet.pickers_file);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", name.c_str(), e.what());
     return;
   }
-  map_ = obtainMap(nh_, pnh_);
+  map_ = obtainMap(nh_, o.common);
   if (!map_) return;
   try {
     planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, config);
@@ -98,7 +72,8 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   // A map edited at run time: the planner is built again on it (same configuration); the last plan, which
   // names nodes of the old map, is forgotten. Beliefs and goals are kept by node name.
   map_follower_ = std::make_unique<MapFollower>(
-      nh_, pnh_, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+      nh_, o.common, map_,
+      [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
         try {
           auto rebuilt = std::make_unique<nbs::NextBestSensePlanner>(m, planner_->config());
           planner_ = std::move(rebuilt);
@@ -112,35 +87,24 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
 
   // Inputs: the trackers' beliefs (never ground truth), the other robots' goals, the battery.
   beliefs_ = std::make_unique<FleetBeliefs>(
-      nh_, pnh_, [this](const picker_localisation::PickerBelief& b) { beliefCallback(b); });
+      nh_, o.fleet.belief_topic, [this](const picker_localisation::PickerBelief& b) { beliefCallback(b); });
   applyPickerList(registry.ids());
-  registry_sub_ = followPickerList(nh_, pnh_, name.c_str(),
+  registry_sub_ = followPickerList(nh_, o.fleet, name.c_str(),
                                    [this](const core::PickerRegistry& r) { applyPickerList(r.ids()); });
-  std::vector<std::string> fleet;
-  if (!pnh_.getParam("fleet", fleet)) {
-    int robots = 1;
-    pnh_.param("num_robots", robots, 1);
-    for (int r = 1; r <= robots; ++r) fleet.push_back("robot_" + std::to_string(r));
-  }
-  for (const std::string& other : fleet)
+  for (const std::string& other : o.robotIds())
     if (other != robot_id_)
       peer_subs_.push_back(nh_.subscribe("/" + other + "/goal", 5, &NbsPlannerNode::peerGoalCallback, this));
-  std::string battery_topic;
-  pnh_.param<std::string>("battery_topic", battery_topic, "battery");
-  if (!battery_topic.empty())
-    battery_sub_ = nh_.subscribe(battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
+  if (!o.battery_topic.empty())
+    battery_sub_ = nh_.subscribe(o.battery_topic, 5, &NbsPlannerNode::batteryCallback, this);
 
   goal_pub_ = nh_.advertise<picker_localisation::GoalNode>("goal", 1, true);
   // The same goal for navigation stacks that take a pose (move_base_simple/goal style), latched.
-  std::string goal_pose_topic;
-  pnh_.param<std::string>("goal_pose_topic", goal_pose_topic, "goal_pose");
-  if (!goal_pose_topic.empty()) goal_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>(goal_pose_topic, 1, true);
+  if (!o.goal_pose_topic.empty())
+    goal_pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>(o.goal_pose_topic, 1, true);
   marker_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("nbs_candidates", 1, true);
   // The dispatcher's goal for this robot while it serves a call (dispatcher ~goal_topic; "" none).
-  std::string call_goal_topic;
-  pnh_.param<std::string>("call_goal_topic", call_goal_topic, "call_goal");
-  if (!call_goal_topic.empty())
-    call_goal_sub_ = nh_.subscribe(call_goal_topic, 5, &NbsPlannerNode::callGoalCallback, this);
+  if (!o.call_goal_topic.empty())
+    call_goal_sub_ = nh_.subscribe(o.call_goal_topic, 5, &NbsPlannerNode::callGoalCallback, this);
   candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
   diagnostics_.setHardwareID(robot_id_);
   diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);

@@ -66,32 +66,17 @@ std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, 
   }
 }
 
-std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node) {
-  std::string path;
-  if (!pnh.getParam("pickers_file", path)) {
+std::optional<core::PickerRegistry> loadPickerRegistry(const std::string& pickers_file, const char* node) {
+  if (pickers_file.empty()) {
     ROS_FATAL("%s: parameter ~pickers_file (config/pickers.yaml) is required", node);
     return std::nullopt;
   }
   try {
-    return core::PickerRegistry::load(path);
+    return core::PickerRegistry::load(pickers_file);
   } catch (const std::exception& e) {
     ROS_FATAL("%s: %s", node, e.what());
     return std::nullopt;
   }
-}
-
-std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
-                                         const std::vector<std::string>& fallback) {
-  std::vector<std::string> list;
-  if (pnh.getParam(name, list)) return list;
-  std::string text;
-  if (!pnh.getParam(name, text)) return fallback;
-  // "[a, b]" or "a b" or "a,b" from the command line.
-  for (char& c : text)
-    if (c == '[' || c == ']' || c == ',' || c == '\'' || c == '"') c = ' ';
-  std::istringstream in(text);
-  for (std::string item; in >> item;) list.push_back(item);
-  return list;
 }
 
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
@@ -102,9 +87,9 @@ Eigen::Isometry2d planar(const Eigen::Isometry3d& t) {
   return p;
 }
 
-void SilenceWatch::configure(ros::NodeHandle& pnh, std::string what) {
+void SilenceWatch::configure(double warn_after, std::string what) {
   what_ = std::move(what);
-  pnh.param("silent_warn_after", warn_after_, warn_after_);
+  warn_after_ = warn_after;
 }
 
 void SilenceWatch::heard() { last_ = ros::Time::now(); }

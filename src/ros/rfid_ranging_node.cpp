@@ -4,24 +4,25 @@
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/rfid_ranging_node.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
 RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "rfid_ranging");
+  // The node's options; the algorithm's (config/rfid_ranging.yaml) are the struct the offline runner builds.
+  sensors::RfidRangingNodeOptions node_options;
+  if (!loadOptions(pnh, node_options)) return;
+  const sensors::RfidModelOptions& o = node_options.model;
+  const core::CommonNodeOptions& common = node_options.common;
+  const std::optional<core::PickerRegistry> registry_opt =
+      loadPickerRegistry(node_options.fleet.pickers_file, "rfid_ranging");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  // One options schema, shared with the offline runner (config/rfid_ranging.yaml keys).
-  sensors::RfidModelOptions o;
-  if (!loadOptions(pnh, o)) return;
-  core::CommonNodeOptions common;
-  common.tf_timeout = tf_timeout_;
-  if (!loadCommonOptions(pnh, common)) return;
   map_frame_ = common.map_frame;
   stamp_guard_ = StampGuard(common.max_future_stamp);
   tf_timeout_ = common.tf_timeout;
-  map_ = obtainMap(nh, pnh, common.map_timeout);
+  map_ = obtainMap(nh, common);
   if (!map_) return;
   try {
     model_ = std::make_unique<sensors::RfidObservationModel>(registry, map_, o);
@@ -31,19 +32,21 @@ RfidRangingNode::RfidRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
   pub_ = nh.advertise<picker_localisation::Observation>(common.observations_topic, 100);
-  const std::vector<std::string> topics = stringListParam(pnh, "rfid_topics", {"rfid"});
+  const std::vector<std::string> topics = node_options.rfid_topics;
   for (const std::string& t : topics) subs_.push_back(nh.subscribe(t, 100, &RfidRangingNode::onReading, this));
   diagnostics_.setHardwareID("rfid_ranging");
-  silence_.configure(pnh, "RFID reads");
+  silence_.configure(node_options.fleet.silent_warn_after, "RFID reads");
   diagnostics_.add("RFID ranging", this, &RfidRangingNode::diagnose);
   diagnostics_.input("rfid reads");
   diagnostics_.start(nh);
-  registry_sub_ = followPickerList(nh, pnh, "rfid_ranging", [this](const core::PickerRegistry& r) {
-    model_->setRegistry(r);
-    ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());
-  });
+  registry_sub_ =
+      followPickerList(nh, node_options.fleet, "rfid_ranging", [this](const core::PickerRegistry& r) {
+        model_->setRegistry(r);
+        ROS_INFO("rfid_ranging: picker list from the tracker: %zu picker(s)", r.size());
+      });
   map_follower_ = std::make_unique<MapFollower>(
-      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+      nh, common, map_,
+      [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
         map_ = m;
         model_->setMap(std::move(m));
       });

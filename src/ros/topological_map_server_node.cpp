@@ -1,4 +1,5 @@
 #include "picker_localisation/ros/topological_map_server_node.h"
+#include "picker_localisation/topology/map_server_options.h"
 
 #include <cmath>
 
@@ -12,28 +13,16 @@ namespace picker_localisation {
 namespace ros_adapter {
 
 TopologicalMapServer::TopologicalMapServer(ros::NodeHandle& nh, ros::NodeHandle& pnh) : pnh_(pnh) {
-  std::string map_file;
-  std::string& frame_id = frame_id_;
-  double& node_scale = node_scale_;
-  bool& labels = labels_;
-  if (!pnh.getParam("map_file", map_file) || map_file.empty()) {
+  topology::MapServerOptions o;
+  if (!loadOptions(pnh, o)) return;
+  const std::string& map_file = o.common.map_file;
+  if (map_file.empty()) {
     ROS_FATAL("topological_map_server: parameter ~map_file is required (a tmap2 or legacy tmap file)");
     return;
   }
-  core::CommonNodeOptions common;
-  if (!loadCommonOptions(pnh, common)) return;
-  frame_id = common.map_frame;
-  pnh.param("node_scale", node_scale, node_scale);
-  pnh.param("labels", labels, labels);
-  // Its four keys: a typo is one warning naming the closest, a bad scale one FATAL line (as every node).
-  for (const auto& u :
-       core::unknownKeys(paramsAsYaml(pnh), {"map_file", "map_frame", "frame_id", "node_scale", "labels"},
-                         "topological_map_server"))
-    ROS_WARN("%s", u.c_str());
-  if (!(node_scale > 0.0) || !std::isfinite(node_scale)) {
-    ROS_FATAL("topological_map_server: %s", core::badValue("node_scale", node_scale, "finite and > 0").c_str());
-    return;
-  }
+  frame_id_ = o.common.map_frame;
+  node_scale_ = o.node_scale;
+  labels_ = o.labels;
   try {
     const topology::TopologicalMap map = topology::loadMap(map_file);
     // Not /topological_map: LCAS topological_navigation publishes its own type there.
@@ -72,6 +61,7 @@ void TopologicalMapServer::publish(const topology::TopologicalMap& map) {
 }
 
 bool TopologicalMapServer::reload(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  // The parameter as it is now: a map manager may have pointed it at another file.
   std::string map_file;
   pnh_.getParam("map_file", map_file);
   try {

@@ -1,4 +1,5 @@
 #include "picker_localisation/ros/tpf_tracker_node.h"
+#include "picker_localisation/tpf/tpf_tracker_node_options.h"
 
 #include <picker_localisation/PickerList.h>
 #include <std_msgs/String.h>
@@ -38,8 +39,10 @@ std_msgs::ColorRGBA massColour(double relative) {
 
 YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh) {
   YAML::Node merged(YAML::NodeType::Map);
+  const YAML::Node params = paramsAsYaml(pnh);
   std::string file;
-  if (pnh.getParam("tpf_params_file", file) && !file.empty()) {
+  core::readOption(params, "tpf_tracker", "tpf_params_file", file);
+  if (!file.empty()) {
     try {
       merged = YAML::LoadFile(file);
     } catch (const YAML::Exception& e) {
@@ -47,7 +50,7 @@ YAML::Node tpfYamlFromRos(const ros::NodeHandle& pnh) {
     }
     if (!merged.IsMap()) merged = YAML::Node(YAML::NodeType::Map);
   }
-  for (const auto& kv : paramsAsYaml(pnh)) merged[kv.first.as<std::string>()] = kv.second;
+  for (const auto& kv : params) merged[kv.first.as<std::string>()] = kv.second;
   return merged;
 }
 
@@ -214,40 +217,13 @@ struct TpfTracker::Track {
 };
 
 TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), diagnostics_(nh, pnh) {
-  std::string pickers_file, single_id;
-  pnh.param<std::string>("pickers_file", pickers_file, "");
-  pnh.param<std::string>("picker_id", single_id, "");
-  try {
-    if (!pickers_file.empty()) {
-      registry_ = core::PickerRegistry::load(pickers_file);
-    } else if (!single_id.empty()) {
-      core::PickerConfig one;
-      one.id = single_id;
-      registry_ = core::PickerRegistry({one}, "~picker_id");
-    } else {
-      ROS_FATAL("tpf_tracker: set ~pickers_file (config/pickers.yaml) or ~picker_id");
-      return;
-    }
-    base_params_ = tpfYamlFromRos(pnh);
-    // The pickers file's and picker_id's keys are this node's, not the filter's.
-    for (const char* own :
-         {"pickers_file", "picker_id", "tpf_params_file", "seed", "topic_prefix", "on_demand_topics_above",
-          "demand_poll_period", "gnss_ingest", "current_node_namespace"})
-      base_params_.remove(own);
-    for (const std::string& shared : core::CommonNodeOptions::acceptedKeys()) base_params_.remove(shared);
-    // A bad shared value is one FATAL line, not one per picker; an unknown key (a typo) one warning.
-    std::vector<std::string> unknown;
-    tpf::TpfParams::fromYaml(base_params_, &unknown);
-    for (const std::string& u : unknown) ROS_WARN("tpf_tracker: %s", u.c_str());
-  } catch (const std::exception& e) {
-    ROS_FATAL("tpf_tracker: %s", e.what());
-    return;
-  }
-  core::CommonNodeOptions common;
-  if (!loadCommonOptions(pnh, common)) return;
+  tpf::TpfTrackerNodeOptions node_options;
+  if (!loadOptionsAndPickers(pnh, node_options)) return;
+  const std::string& pickers_file = node_options.fleet.pickers_file;
+  const core::CommonNodeOptions& common = node_options.common;
   frame_id_ = common.map_frame;
-  pnh.param("seed", seed_param_, 0);
-  map_ = obtainMap(nh, pnh);
+  seed_param_ = node_options.seed;
+  map_ = obtainMap(nh, common);
   if (!map_) return;  // obtainMap logged why
   fleet_ = std::make_unique<tpf::TrackerFleet>(map_, [this](tpf::TrackerFleet::Track& core) {
     const auto it = tracks_.find(core.id);
@@ -255,17 +231,19 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   });
 
   const std::string observations_topic = common.observations_topic;
-  pnh.param<std::string>("topic_prefix", prefix_, "/pickers");
+  prefix_ = node_options.topic_prefix;
   // LCAS topological_navigation's coordination reads an agent's node from <agent>/current_node (std_msgs/String):
   // <current_node_namespace>/<id>/current_node, so "/" gives /<id>/current_node; "" publishes none.
-  pnh.param<std::string>("current_node_namespace", current_node_ns_, prefix_);
+  current_node_ns_ = node_options.currentNodeNamespace();
   ordering_latency_ = orderingLatency(common.ordering_latency, 0.5);
   stamp_guard_ = StampGuard(common.max_future_stamp);
   // Per-picker topics on demand above ~on_demand_topics_above pickers (see advertiseTopics).
-  on_demand_.start(nh, pnh, registry_.size(), [this] { return tracks_.size(); }, [this] {
-    flush();
-    for (auto& kv : tracks_) advertiseTopics(*kv.second);
-  });
+  on_demand_.start(
+      nh, node_options.fleet, registry_.size(), [this] { return tracks_.size(); },
+      [this] {
+        flush();
+        for (auto& kv : tracks_) advertiseTopics(*kv.second);
+      });
   ordering_ = core::StampOrderedBuffer<Pending>(ordering_latency_, 10000 + 20 * registry_.size());
 
   const std::vector<core::PickerConfig> initial = registry_.pickers();
@@ -301,13 +279,47 @@ TpfTracker::TpfTracker(ros::NodeHandle& nh, ros::NodeHandle& pnh) : nh_(nh), dia
   diagnostics_.input("observations");
   diagnostics_.start(nh);
   map_follower_ =
-      std::make_unique<MapFollower>(nh_, pnh, map_,
+      std::make_unique<MapFollower>(nh_, node_options.common, map_,
                                     [this](std::shared_ptr<const topology::TopologicalMap> m,
                                            const topology::MapChange& c) { adoptMap(std::move(m), c); });
   ROS_INFO("tpf_tracker: %zu picker(s), map '%s' (%zu nodes), ordering latency %.2f s (%s)", tracks_.size(),
            map_->name().c_str(), map_->numNodes(), ordering_latency_,
            ordering_latency_ > 0.0 ? "stamp-ordered replay" : "fused on arrival");
   ok_ = true;
+}
+
+// The node's options (its parameters over tpf_params_file's keys), the filters' base (the filter's keys of
+// the same map) and the picker list. False after one FATAL line.
+bool TpfTracker::loadOptionsAndPickers(const ros::NodeHandle& pnh, tpf::TpfTrackerNodeOptions& out) {
+  try {
+    const YAML::Node merged = tpfYamlFromRos(pnh);
+    std::vector<std::string> messages;
+    out = tpf::TpfTrackerNodeOptions::fromYaml(merged, &messages);
+    for (const std::string& m : messages) ROS_WARN("%s", m.c_str());
+    base_params_ = YAML::Clone(merged);
+    for (const std::string& own : tpf::TpfTrackerNodeOptions::nodeKeys()) base_params_.remove(own);
+  } catch (const std::exception& e) {
+    ROS_FATAL("tpf_tracker: %s", e.what());
+    return false;
+  }
+  const std::string& pickers_file = out.fleet.pickers_file;
+  const std::string& single_id = out.picker_id;
+  try {
+    if (!pickers_file.empty()) {
+      registry_ = core::PickerRegistry::load(pickers_file);
+    } else if (!single_id.empty()) {
+      core::PickerConfig one;
+      one.id = single_id;
+      registry_ = core::PickerRegistry({one}, "~picker_id");
+    } else {
+      ROS_FATAL("tpf_tracker: set ~pickers_file (config/pickers.yaml) or ~picker_id");
+      return false;
+    }
+  } catch (const std::exception& e) {
+    ROS_FATAL("tpf_tracker: %s", e.what());
+    return false;
+  }
+  return true;
 }
 
 TpfTracker::~TpfTracker() { ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<std::uint64_t>(this)); }

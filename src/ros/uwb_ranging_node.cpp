@@ -5,27 +5,26 @@
 #include "picker_localisation/ros/observation_conversions.h"
 #include "picker_localisation/ros/param_yaml.h"
 #include "picker_localisation/ros/uwb_ranging_node.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
 
 UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
-  const std::optional<core::PickerRegistry> registry_opt = loadPickerRegistry(pnh, "uwb_ranging");
+  // The node's options; the algorithm's (config/uwb_ranging.yaml) are the struct the offline runner builds.
+  sensors::UwbRangingNodeOptions node_options;
+  if (!loadOptions(pnh, node_options)) return;
+  const sensors::UwbRangingOptions& o = node_options.ranging;
+  const core::CommonNodeOptions& common = node_options.common;
+  const std::optional<core::PickerRegistry> registry_opt =
+      loadPickerRegistry(node_options.fleet.pickers_file, "uwb_ranging");
   if (!registry_opt) return;
   const core::PickerRegistry& registry = *registry_opt;
-  // One options schema, shared with the offline runner (config/uwb_ranging.yaml keys).
-  sensors::UwbRangingOptions o;
-  if (!loadOptions(pnh, o)) return;
-  core::CommonNodeOptions common;
-  common.tf_timeout = tf_timeout_;
-  if (!loadCommonOptions(pnh, common)) return;
   map_frame_ = common.map_frame;
   stamp_guard_ = StampGuard(common.max_future_stamp);
   tf_timeout_ = common.tf_timeout;
-  pnh.param<std::string>("base_frame", base_frame_, "");
-  double flush_period = 0.05;
-  pnh.param("flush_period", flush_period, flush_period);
-  map_ = obtainMap(nh, pnh, common.map_timeout);
+  base_frame_ = node_options.base_frame;
+  map_ = obtainMap(nh, common);
   if (!map_) return;
   try {
     uwb_ = std::make_unique<sensors::UwbRanging>(registry, map_, o);
@@ -35,24 +34,27 @@ UwbRangingNode::UwbRangingNode(ros::NodeHandle& nh, ros::NodeHandle& pnh) {
   }
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(tf_buffer_);
   pub_ = nh.advertise<picker_localisation::Observation>(common.observations_topic, 100);
-  const std::vector<std::string> uwb_topics = stringListParam(pnh, "uwb_topics", {"uwb"});
-  const std::vector<std::string> bearing_topics = stringListParam(pnh, "bearing_topics", {});
+  const std::vector<std::string> uwb_topics = node_options.uwb_topics;
+  const std::vector<std::string> bearing_topics = node_options.bearing_topics;
   for (const std::string& t : uwb_topics) subs_.push_back(nh.subscribe(t, 200, &UwbRangingNode::onRange, this));
   for (const std::string& t : bearing_topics)
     subs_.push_back(nh.subscribe(t, 20, &UwbRangingNode::onBearings, this));
-  flush_timer_ = nh.createWallTimer(ros::WallDuration(std::max(flush_period, 0.005)), &UwbRangingNode::onFlush, this);
+  flush_timer_ = nh.createWallTimer(ros::WallDuration(std::max(node_options.flush_period, 0.005)),
+                                    &UwbRangingNode::onFlush, this);
   diagnostics_.setHardwareID("uwb_ranging");
-  silence_.configure(pnh, "UWB ranges");
+  silence_.configure(node_options.fleet.silent_warn_after, "UWB ranges");
   diagnostics_.add("UWB ranging", this, &UwbRangingNode::diagnose);
   diagnostics_.input("uwb ranges");
   diagnostics_.input("bearings");
   diagnostics_.start(nh);
-  registry_sub_ = followPickerList(nh, pnh, "uwb_ranging", [this](const core::PickerRegistry& r) {
-    uwb_->setRegistry(r);
-    ROS_INFO("uwb_ranging: picker list from the tracker: %zu picker(s)", r.size());
-  });
+  registry_sub_ =
+      followPickerList(nh, node_options.fleet, "uwb_ranging", [this](const core::PickerRegistry& r) {
+        uwb_->setRegistry(r);
+        ROS_INFO("uwb_ranging: picker list from the tracker: %zu picker(s)", r.size());
+      });
   map_follower_ = std::make_unique<MapFollower>(
-      nh, pnh, map_, [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
+      nh, common, map_,
+      [this](std::shared_ptr<const topology::TopologicalMap> m, const topology::MapChange&) {
         map_ = m;
         uwb_->setMap(std::move(m));
       });

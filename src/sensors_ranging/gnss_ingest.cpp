@@ -39,47 +39,20 @@ GnssIngestOptions GnssIngestOptions::fromYaml(const YAML::Node& y, std::vector<s
   count("jump_reset_count", o.jump_reset_count);
   o.bias = GnssBiasOptions::fromYaml(y);
   o.association = PickerAssociationOptions::fromYaml(y);
-  std::vector<std::string> known = {"default_sigma",
-                                    "min_sigma",
-                                    "cutoff_sigmas",
-                                    "max_nodes",
-                                    "velocity_window",
-                                    "max_speed",
-                                    "jump_gate_sigmas",
-                                    "jump_reset_count",
-                                    "blackout_timeout",
-                                    "max_map_distance",
-                                    "pickers_file",
-                                    "datum_file",
-                                    "datum_source",
-                                    "map_file",
-                                    "map_timeout",
-                                    "frame_id",
-                                    "map_frame",
-                                    "observation_topic",
-                                    "observations_topic",
-                                    "tf_timeout",
-                                    "map_topic",
-                                    "max_future_stamp",
-                                    "silent_warn_after",
-                                    "people_pose_topics",
-                                    "people_pose_sensor",
-                                    "people_pose_sigma",
-                                    "pose_topic_format",
-                                    "pose_sensor",
-                                    "person_observation_topic",
-                                    "belief_topic",
-                                    "bias_topic_prefix",
-                                    "ordering_latency",
-                                    "registry_topic",
-                                    "registry_publisher",
-                                    "max_people_per_message",
-                                    "on_demand_topics_above",
-                                    "demand_poll_period"};
-  known.insert(known.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
-  known.insert(known.end(), PickerAssociationOptions::yamlKeys().begin(),
-               PickerAssociationOptions::yamlKeys().end());
-  return core::checkOptions(o, y, known, c, unknown);
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
+}
+
+const std::vector<std::string>& GnssIngestOptions::yamlKeys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k{"default_sigma",    "min_sigma",       "cutoff_sigmas",    "max_nodes",
+                               "velocity_window",  "max_speed",       "jump_gate_sigmas", "jump_reset_count",
+                               "blackout_timeout", "max_map_distance"};
+    k.insert(k.end(), GnssBiasOptions::yamlKeys().begin(), GnssBiasOptions::yamlKeys().end());
+    k.insert(k.end(), PickerAssociationOptions::yamlKeys().begin(),
+             PickerAssociationOptions::yamlKeys().end());
+    return k;
+  }();
+  return keys;
 }
 
 GnssIngestOptions GnssIngestOptions::fromYamlFile(const std::string& path,

@@ -33,38 +33,7 @@ RfidModelOptions RfidModelOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "p_detect", o.p_detect);
   core::readOption(y, c, "attempt_rate", o.attempt_rate);
   core::readOption(y, c, "max_failed_attempts", o.max_failed_attempts);
-  static const std::vector<std::string> known = {"read_model",
-                                                 "p_max",
-                                                 "d50",
-                                                 "width",
-                                                 "max_range",
-                                                 "height_difference",
-                                                 "min_relative",
-                                                 "read_range",
-                                                 "beam_half_angle",
-                                                 "min_rssi",
-                                                 "out_of_order_tolerance",
-                                                 "negative_information",
-                                                 "negative_window",
-                                                 "negative_period",
-                                                 "attempt_rate",
-                                                 "max_failed_attempts",
-                                                 "p_detect",
-                                                 "map_frame",
-                                                 "observation_topic",
-                                                 "observations_topic",
-                                                 "ordering_latency",
-                                                 "rfid_topics",
-                                                 "tf_timeout",
-                                                 "map_timeout",
-                                                 "map_file",
-                                                 "pickers_file",
-                                                 "map_topic",
-                                                 "silent_warn_after",
-                                                 "max_future_stamp",
-                                                 "registry_topic",
-                                                 "registry_publisher"};
-  return core::checkOptions(o, y, known, c, unknown);
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
 }
 
 std::string RfidModelOptions::validate() const {
@@ -87,6 +56,27 @@ std::string RfidModelOptions::validate() const {
   if (!(d50 > 0.0) || !std::isfinite(d50)) return bad("d50", d50, "finite and > 0");
   if (!std::isfinite(height_difference)) return bad("height_difference", height_difference, "finite");
   return "";
+}
+
+const std::vector<std::string>& RfidModelOptions::yamlKeys() {
+  static const std::vector<std::string> keys{"read_model",
+                                             "p_max",
+                                             "d50",
+                                             "width",
+                                             "max_range",
+                                             "height_difference",
+                                             "min_relative",
+                                             "read_range",
+                                             "beam_half_angle",
+                                             "min_rssi",
+                                             "out_of_order_tolerance",
+                                             "negative_information",
+                                             "negative_window",
+                                             "negative_period",
+                                             "attempt_rate",
+                                             "max_failed_attempts",
+                                             "p_detect"};
+  return keys;
 }
 
 RfidModelOptions RfidModelOptions::fromYamlFile(const std::string& path, std::vector<std::string>* unknown) {

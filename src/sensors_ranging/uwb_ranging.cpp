@@ -48,17 +48,15 @@ const char* toString(UwbRejection r) {
   return "unknown";
 }
 
-// The RHF's keys in the node's files (names of Sarmento et al. 2024), then the ranging keys, then the node's own keys.
+// The RHF's keys (names of Sarmento et al. 2024), then the ranging keys; the node's own:
+// UwbRangingNodeOptions.
 const std::vector<std::string>& UwbRangingOptions::yamlKeys() {
   static const std::vector<std::string> keys{
-      "grid_size_x", "grid_size_y", "grid_resolution", "max_speed", "p_threshold", "p_min_uwb", "p_min_cam",
-      "p_min_obs", "p_min_inov", "default_range_sigma", "bearing_sigma", "output_threshold", "camera_gate",
-      "max_range", "batch_window", "bearing_max_age", "pdoa_mode", "pdoa_angle_sigma", "min_sigma",
-      "cutoff_sigmas", "reset_after", "max_output_sigma",
-      // uwb_ranging node
-      "map_frame", "base_frame", "observation_topic", "observations_topic", "ordering_latency",
-      "max_future_stamp", "uwb_topics", "bearing_topics", "tf_timeout", "map_timeout", "flush_period",
-      "map_file", "pickers_file", "map_topic", "silent_warn_after", "registry_topic", "registry_publisher"};
+      "grid_size_x",     "grid_size_y",      "grid_resolution",  "max_speed",  "p_threshold",
+      "p_min_uwb",       "p_min_cam",        "p_min_obs",        "p_min_inov", "default_range_sigma",
+      "bearing_sigma",   "output_threshold", "camera_gate",      "max_range",  "batch_window",
+      "bearing_max_age", "pdoa_mode",        "pdoa_angle_sigma", "min_sigma",  "cutoff_sigmas",
+      "reset_after",     "max_output_sigma"};
   return keys;
 }
 

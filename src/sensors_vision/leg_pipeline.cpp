@@ -11,31 +11,7 @@
 namespace picker_localisation {
 namespace vision {
 
-namespace {
-
-// Keys the leg_detector node reads itself (topics, frames, model, timeouts): valid here, not used here.
-const std::vector<std::string>& nodeOnlyKeys() {
-  static const std::vector<std::string> keys = {"scan_topics",
-                                                "cloud_topic",
-                                                "detections_topic",
-                                                "camera_info_topic",
-                                                "model_file",
-                                                "fixed_frame",
-                                                "robot_id",
-                                                "tf_timeout",
-                                                "map_file",
-                                                "map_timeout",
-                                                "publish_observations",
-                                                "observations_topic",
-                                                "fusion_max_age",
-                                                "map_topic",
-                                                "max_future_stamp",
-                                                "max_beams",
-                                                "map_frame",
-                                                "ordering_latency"};
-  return keys;
-}
-const std::vector<std::string>& pipelineKeys() {
+const std::vector<std::string>& LegPipelineOptions::yamlKeys() {
   static const std::vector<std::string> keys = {
       "leg_threshold",    "max_leg_range",      "max_pair_distance", "single_leg_people",
       "jump_distance",    "min_cluster_points", "gate_distance",     "hits_to_confirm",
@@ -46,6 +22,8 @@ const std::vector<std::string>& pipelineKeys() {
       "negative_range_max",   "negative_clearance"};
   return keys;
 }
+
+namespace {
 
 template <typename T>
 void read(const YAML::Node& y, const char* key, T& value) {
@@ -97,16 +75,12 @@ LegPipelineOptions LegPipelineOptions::fromYaml(const YAML::Node& y, std::vector
   read(y, "camera_fusion", o.camera_fusion);
   const std::string problem = o.validate();
   if (!problem.empty()) throw std::runtime_error("leg_detector: " + problem);
-  if (unknown) {
-    std::vector<std::string> known = pipelineKeys();
-    known.insert(known.end(), nodeOnlyKeys().begin(), nodeOnlyKeys().end());
-    for (auto& m : core::unknownKeys(y, known, "leg_detector")) unknown->push_back(std::move(m));
-  }
+  if (unknown)
+    for (auto& m : core::unknownKeys(y, yamlKeys(), "leg_detector")) unknown->push_back(std::move(m));
   return o;
 }
 
-LegPipelineOptions LegPipelineOptions::fromYamlFiles(const std::vector<std::string>& files,
-                                                     std::vector<std::string>* unknown) {
+YAML::Node LegPipelineOptions::mergedSections(const std::vector<std::string>& files) {
   // Merge the sections key by key (later files win), then parse once.
   YAML::Node merged(YAML::NodeType::Map);
   for (const auto& f : files) {
@@ -117,7 +91,12 @@ LegPipelineOptions LegPipelineOptions::fromYamlFiles(const std::vector<std::stri
       return 0;
     });
   }
-  return fromYaml(merged, unknown);
+  return merged;
+}
+
+LegPipelineOptions LegPipelineOptions::fromYamlFiles(const std::vector<std::string>& files,
+                                                     std::vector<std::string>* unknown) {
+  return fromYaml(mergedSections(files), unknown);
 }
 
 std::string LegPipelineOptions::validate() const {

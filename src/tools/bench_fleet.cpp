@@ -1,15 +1,17 @@
-// bench_fleet: a whole farm through the real nodes, on their own ROS master (issue "Track a whole farm in one
-// process"). Starts rosmaster on a free port, gnss_ingest (config/gnss_ingest.yaml) and the tracker
-// (config/tpf.yaml, --particles), N simulated pickers walking their lanes and publishing sensor_msgs/NavSatFix
-// at R Hz (evenly spread in time, 1 m white noise, seeded), and listens to every /pickers/<id>/belief.
-// Measured over the window after --warmup: CPU of the tracker and gnss_ingest processes (from /proc, in cores),
-// their total resident memory, latency from a fix's stamp (its wall publish time) to the belief of that fix,
-// and how many fixes became a belief. Human-readable lines go to stderr; the last line of stdout is one JSON
-// object: pickers, rate_hz, duration_s, particles, trackers, cpu_cores, cpu_cores_tracker, cpu_cores_ingest,
-// rss_mb, latency_p50_ms, latency_p99_ms, latency_max_ms, observations, beliefs, startup_s.
+// bench_fleet: a whole farm through the real nodes, on their own ROS master (every picker of a farm in one
+// process). Starts rosmaster on a free port, gnss_ingest (config/gnss_ingest.yaml) and the tracker
+// (config/tpf.yaml, --particles), N simulated pickers walking their lanes and publishing
+// sensor_msgs/NavSatFix at R Hz (evenly spread in time, 1 m white noise, seeded), and listens to every
+// /pickers/<id>/belief. Measured over the window after --warmup: CPU of the tracker and gnss_ingest processes
+// (from /proc, in cores), their total resident memory, latency from a fix's stamp (its wall publish time) to
+// the belief of that fix, and how many fixes became a belief. Human-readable lines go to stderr; the last
+// line of stdout is one JSON object: pickers, rate_hz, duration_s, particles, trackers, cpu_cores,
+// cpu_cores_tracker, cpu_cores_ingest, rss_mb, latency_p50_ms, latency_p99_ms, latency_max_ms, observations,
+// beliefs, startup_s.
 //
 //   bench_fleet --pickers 1000 --rate 1 --duration 30 --particles 1000
-//   bench_fleet --pickers 100 --trackers per_picker   # one tpf_tracker process per picker (ordering 0.5 s), as
+//   bench_fleet --pickers 100 --trackers per_picker   # one tpf_tracker process per picker (ordering 0.5 s),
+//   as
 //                                                     # before one node tracked them all
 //
 // Wall time is what is measured here (a live deployment); nothing in the nodes reads it.

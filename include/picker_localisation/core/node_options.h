@@ -22,7 +22,8 @@ struct CommonNodeOptions {
   double tf_timeout = 0.2;         // s to wait for a transform
   double ordering_latency = -1.0;  // s inputs are held to be fused in stamp order (< 0: the node's default)
   std::string map_file;            // tmap2 / tmap file ("": the latched map topic)
-  std::string map_topic;           // the map topic ("": /topological_map, or LCAS's when it is there)
+  std::string
+      map_topic;  // the map topic ("": the global /map_topic, else /picker_localisation/topological_map)
   double map_timeout = 30.0;       // s to wait for the map topic at start-up (0: for ever)
 
   std::string validate() const;  // "" or "<key> = <value>: must be ..."
@@ -36,6 +37,21 @@ struct CommonNodeOptions {
                                     std::vector<std::string>* warnings, CommonNodeOptions defaults);
   // yamlKeys() and the old names: what a node's unknown-key check accepts besides its own keys.
   static std::vector<std::string> acceptedKeys();
+};
+
+// The keys of the helpers several nodes share: the picker list, the tracker's list and belief stream, topics
+// advertised on demand, the silence watch. Each node's options table lists the ones it uses.
+struct FleetTopicOptions {
+  std::string pickers_file;                          // config/pickers.yaml format
+  std::string registry_topic = "/pickers/registry";  // the tracker's latched picker list ("" not followed)
+  std::string registry_publisher = "/tpf_tracker";   // only this node's lists are followed ("" any)
+  std::string belief_topic =
+      "/pickers/beliefs";  // every picker's belief (PickerBeliefArray; "" each /pickers/<id>/belief)
+  int on_demand_topics_above = 100;  // pickers: above this, per-picker topics while subscribed
+  double demand_poll_period = 2.0;   // s between asking the master who subscribes (>= 0.2)
+  double silent_warn_after = 30.0;   // s of silence on an input before diagnostics WARN (0 never)
+
+  std::string validate() const;  // "" or "<key> = <value>: must be ..."
 };
 
 }  // namespace core

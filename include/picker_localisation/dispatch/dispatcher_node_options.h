@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/dispatch/call_dispatcher.h"
 
 namespace YAML {
@@ -41,6 +42,8 @@ struct DispatcherNodeOptions {
   std::string calls_log;
   std::string datum_file;           // for a call's fix when the map has no datum
   std::string datum_source = "auto";  // auto | file | map (as gnss_ingest)
+  core::FleetTopicOptions fleet;      // belief_topic, registry_topic, registry_publisher
+  core::CommonNodeOptions map_source;  // map_file, map_topic, map_timeout
   DispatcherOptions dispatcher;
 
   std::vector<std::string> robotIds() const;

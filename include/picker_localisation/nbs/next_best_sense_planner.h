@@ -102,15 +102,16 @@ struct PlannerConfig {
   std::string validate() const;  // "" when valid
 
   // Keys as config/nbs.yaml (missing keys keep the defaults). Throws std::runtime_error naming the key. With
-  // `unknown`, one message per key that is neither the planner's (yamlKeys(), and the sub-keys of weights,
-  // rfid, energy) nor the nbs_planner node's (nodeKeys()) is appended, naming the closest
-  // known key.
+  // `unknown`, one message per key that is not the planner's (yamlKeys(), and the sub-keys of weights,
+  // rfid, energy) is appended, naming the closest known key. The nbs_planner node's own keys, which
+  // config/nbs.yaml holds too: NbsPlannerNodeOptions.
   static PlannerConfig fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static PlannerConfig fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
   static const std::vector<std::string>& yamlKeys();
-  // Parameters of the nbs_planner node (and the runner's planning_period / battery_level / what_if_seed) that
-  // config/nbs.yaml may hold beside the planner's own keys.
-  static const std::vector<std::string>& nodeKeys();
+  // One message per key of `node` that is neither the planner's nor in `also_known`, and per unknown key of
+  // the weights, rfid and energy sections, each naming the closest known key.
+  static std::vector<std::string> unknownKeys(const YAML::Node& node,
+                                              const std::vector<std::string>& also_known);
 };
 
 // A goal taken by another robot.

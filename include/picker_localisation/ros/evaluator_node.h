@@ -18,6 +18,8 @@
 #include <geometry_msgs/PoseStamped.h>
 
 #include <ros/ros.h>
+
+#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/ros/fleet_topics.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
@@ -45,6 +47,8 @@ struct EvaluatorOptions {
   double ordering_latency = 1.5;     // s
   double max_truth_distance = 50.0;  // m, a truth farther from every node is not scored
   double max_future_stamp = 10.0;    // s
+  std::string belief_topic = core::FleetTopicOptions().belief_topic;  // "" each picker's own belief topic
+  std::string map_file, map_topic;  // the map source (core::CommonNodeOptions)
 
   // A bad value throws std::runtime_error "evaluator: <key> = <value>: must be ..."; an unknown key goes to
   // *unknown with the closest known one.

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "picker_localisation/ros/ranging_nodes.h"
+#include "picker_localisation/sensors_ranging/ranging_node_options.h"
 
 namespace picker_localisation {
 namespace ros_adapter {
@@ -65,6 +66,9 @@ class GnssIngestNode {
   bool checkClock();
   // A new map from the map topic (MapFollower): every picker's ingest, and the datum when the map's moved.
   void adoptMap(std::shared_ptr<const topology::TopologicalMap> map, const topology::MapChange& change);
+  bool loadDatum();
+  void subscribePeople(ros::NodeHandle& nh, const sensors::GnssIngestNodeOptions& node_options,
+                       const core::PickerRegistry& registry);
   void releaseOrdered();
   void processFix(Picker& picker, const core::GnssFix& fix);
   void processPerson(const core::Observation& person);

@@ -1,9 +1,10 @@
-// Publishers that cost nothing while nobody listens (issue "Track a whole farm in one process"). In roscpp every
-// publish to a latched topic serialises the message and wakes the poll thread, which then walks every publication
-// of the process; ros::Publisher::getNumSubscribers() finds its topic by a linear scan of them; every socket
-// write rebuilds the poll set. With thousands of per-picker topics in one node that, not the filters, was the
-// cost (measured with perf and bench_fleet).
-//  * CountedPublisher: the subscriber count kept from connect / disconnect callbacks; an optional `on_connect`
+// Publishers that cost nothing while nobody listens. In roscpp every
+// publish to a latched topic serialises the message and wakes the poll thread, which then walks every
+// publication of the process; ros::Publisher::getNumSubscribers() finds its topic by a linear scan of them;
+// every socket write rebuilds the poll set. With thousands of per-picker topics in one node that, not the
+// filters, was the cost (measured with perf and bench_fleet).
+//  * CountedPublisher: the subscriber count kept from connect / disconnect callbacks; an optional
+//  `on_connect`
 //    sends a new subscriber something at once.
 //  * LastValuePublisher: latched semantics (a new subscriber gets the last message at once), a message sent
 //    only when the topic has subscribers; it may be advertised and shut down again (TopicDemand) while it
@@ -13,6 +14,8 @@
 #pragma once
 
 #include <ros/ros.h>
+
+#include "picker_localisation/core/node_options.h"
 
 #include <atomic>
 #include <functional>
@@ -118,7 +121,8 @@ class OnDemandTopics {
   OnDemandTopics() = default;
   // `expected`: the pickers the node starts with (polling starts at once when they are many); `pickers`: how
   // many it has now; `sweep`: re-applies advertiseWhileWanted to every per-picker topic.
-  void start(ros::NodeHandle& nh, const ros::NodeHandle& pnh, std::size_t expected,
+  // fleet: on_demand_topics_above, demand_poll_period.
+  void start(ros::NodeHandle& nh, const core::FleetTopicOptions& fleet, std::size_t expected,
              std::function<std::size_t()> pickers, std::function<void()> sweep);
   bool onDemand() const { return pickers_ && pickers_() > above_; }
   // What to advertise by: nullptr (always) unless on demand.

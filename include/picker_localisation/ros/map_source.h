@@ -11,8 +11,10 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
+#include "picker_localisation/core/node_options.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
@@ -21,19 +23,23 @@ namespace ros_adapter {
 // The topic topological_map_server publishes on (latched).
 constexpr const char* kMapTopic = "/picker_localisation/topological_map";
 
-// Returns the map, or nullptr after logging one FATAL line (bad file, bad map text, wrong topic type, or no map
-// within timeout seconds; timeout <= 0 waits forever). Sim time aware: the wait uses wall time so it cannot
-// stall on a paused clock.
-std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh, ros::NodeHandle& pnh,
-                                                          double timeout = 30.0);
+// Returns the map, or nullptr after logging one FATAL line (bad file, bad map text, wrong topic type, or no
+// map within timeout seconds; timeout <= 0 waits forever). Sim time aware: the wait uses wall time so it
+// cannot stall on a paused clock. The source: common.map_file, else common.map_topic (each falling back to
+// the global /map_file, /map_topic), waiting common.map_timeout s.
+std::shared_ptr<const topology::TopologicalMap> obtainMap(ros::NodeHandle& nh,
+                                                          const core::CommonNodeOptions& common);
+// The map keys of a node without an options struct of its own (farm_sim, evaluator, dispatcher); nullopt
+// after one FATAL line on a bad value.
+std::optional<core::CommonNodeOptions> mapOptionsOf(const ros::NodeHandle& pnh);
 
 // ~datum_source (auto | file | map) of the nodes that turn WGS84 into map coordinates (gnss_ingest, farm_sim):
 // true when the map's own datum (tmap2 meta.datum_*) is to be used: `map`, or `auto` and the map has one.
 // Throws std::runtime_error on another value, or `map` for a map without a datum.
 bool useMapDatum(const std::string& datum_source, const topology::TopologicalMap& map);
 
-// The map topic obtainMap() reads (~map_topic, /map_topic or kMapTopic), resolved.
-std::string mapTopic(ros::NodeHandle& nh, ros::NodeHandle& pnh);
+// The map topic obtainMap() reads (map_topic, /map_topic or kMapTopic), resolved.
+std::string mapTopic(ros::NodeHandle& nh, const core::CommonNodeOptions& common);
 
 // The map after start-up: a map manager may edit it while the robot runs (LCAS topological_navigation
 // re-publishes /topological_map_2; topological_map_server's ~reload). Every node that read its map from the
@@ -46,7 +52,7 @@ class MapFollower {
  public:
   using Adopt = std::function<void(std::shared_ptr<const topology::TopologicalMap> map,
                                    const topology::MapChange& change)>;
-  MapFollower(ros::NodeHandle& nh, ros::NodeHandle& pnh,
+  MapFollower(ros::NodeHandle& nh, const core::CommonNodeOptions& common,
               std::shared_ptr<const topology::TopologicalMap> current, Adopt adopt);
   ~MapFollower();
   MapFollower(const MapFollower&) = delete;

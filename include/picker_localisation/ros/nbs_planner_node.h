@@ -38,10 +38,6 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
-// Reads the planner configuration from a parameter namespace laid out like config/nbs.yaml (missing keys keep
-// the defaults). Throws std::runtime_error naming the key on a bad value.
-nbs::PlannerConfig plannerConfigFromParams(const ros::NodeHandle& pnh);
-
 class NbsPlannerNode {
  public:
   NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh);

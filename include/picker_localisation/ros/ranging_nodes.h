@@ -55,14 +55,15 @@ sensor_msgs::NavSatFix navSatFixAt(const core::GeodeticDatum& datum, const Eigen
 std::optional<Eigen::Isometry3d> lookupTransform(const tf2_ros::Buffer& buffer, const std::string& target,
                                                  const std::string& source, const ros::Time& stamp,
                                                  double timeout, std::string* error);
-// The picker registry from the required ~pickers_file; nullopt after one ROS_FATAL line naming `node`.
-std::optional<core::PickerRegistry> loadPickerRegistry(ros::NodeHandle& pnh, const char* node);
+// The picker registry from the required pickers_file; nullopt after one ROS_FATAL line naming `node`.
+std::optional<core::PickerRegistry> loadPickerRegistry(const std::string& pickers_file, const char* node);
 // A front-end's input that should be talking (a mistyped topic must not look green): once
-// ~silent_warn_after s of ROS time (default 30; 0 = never) pass without a message, since the start or since the
-// last one, the node's diagnostics go WARN naming the input and how long it has been quiet.
+// warn_after s of ROS time (a node's silent_warn_after, default 30; 0 = never) pass without a message, since
+// the start or since the last one, the node's diagnostics go WARN naming the input and how long it has been
+// quiet.
 class SilenceWatch {
  public:
-  void configure(ros::NodeHandle& pnh, std::string what);
+  void configure(double warn_after, std::string what);
   void heard();  // a message arrived
   // Adds "<what>: seconds since the last" and, when silent too long, merges a WARN into the summary.
   void report(diagnostic_updater::DiagnosticStatusWrapper& stat);
@@ -73,9 +74,6 @@ class SilenceWatch {
   ros::Time start_, last_;
 };
 
-// A list-of-strings parameter; also accepts one string ("[a, b]", "a b") as rosrun _name:=... gives it.
-std::vector<std::string> stringListParam(ros::NodeHandle& pnh, const std::string& name,
-                                         const std::vector<std::string>& fallback);
 // Planar part of a 3D transform: x, y and the yaw of the x axis.
 Eigen::Isometry2d planar(const Eigen::Isometry3d& t);
 

@@ -1,5 +1,5 @@
 // tpf_tracker: the Topological Particle Filters of a whole farm's pickers in one node, one TPF per picker
-// (Navigate-and-Seek Sec. IV; issue "Track a whole farm in one process").
+// (Navigate-and-Seek Sec. IV).
 //
 // Pickers: ~pickers_file (config/pickers.yaml: every entry, each with its optional `tpf:` overrides) or one
 // ~picker_id; more are added and removed at run time with the services ~add_picker (AddPicker),
@@ -70,6 +70,7 @@
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
+#include "picker_localisation/tpf/tpf_tracker_node_options.h"
 #include "picker_localisation/tpf/tracker_fleet.h"
 
 namespace picker_localisation {
@@ -103,6 +104,7 @@ class TpfTracker {
   std::size_t size() const { return tracks_.size(); }
 
  private:
+  bool loadOptionsAndPickers(const ros::NodeHandle& pnh, tpf::TpfTrackerNodeOptions& out);
   struct Track;      // one picker's topics, services and adapter counters (its filter is the fleet's)
   struct Outgoing {  // one belief's messages, queued by publish() and sent by flush()
     Track* track;

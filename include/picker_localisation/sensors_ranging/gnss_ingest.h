@@ -103,6 +103,7 @@ struct GnssIngestOptions {
   // naming the key; `unknown` receives one message per unknown key (with the closest known one).
   static GnssIngestOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static GnssIngestOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();  // the algorithm's keys (bias and association included)
   std::string validate() const;  // "" or "<key> = <value>: must be ..."
   // cutoff_sigmas, min_sigma, max_nodes as core::setGaussianLikelihood takes them.
   core::GaussianLikelihoodOptions likelihoodOptions() const {

@@ -1,7 +1,8 @@
-// Identity for anonymous people detections (issue "Find the lane", Khan et al. 2020, Sec. VI). ROS-free.
+// Identity for anonymous people detections (Khan et al. 2020, Sec. VI: the lane a robot is sent to).
+// ROS-free.
 //
-// A confirmed person from the LiDAR (or camera-fused legs) names nobody. Each picker predicts where it is from
-// two sources:
+// A confirmed person from the LiDAR (or camera-fused legs) names nobody. Each picker predicts where it is
+// from two sources:
 //   g_i(z) = N(z; fix_i - bias_i, P_bias_i + residual^2 I + (speed age)^2 I + R_z)   bias-corrected fix
 //   b_i(z) = sum_n m_i(n) N(z; x_n, belief_sigma^2 I + R_z)                           tracker's belief
 // and the detection's likelihood under "it is picker i" is the mixture l_i = (1 - w) g_i + w b_i (either term
@@ -11,10 +12,10 @@
 // are p_i = l_i / (c + sum_j l_j) (one detection, one picker at most: the standard single-scan PDA form).
 // p_i >= min_probability makes the detection an identifying observation of picker i and a metric sighting for
 // its bias estimate; anything less stays anonymous, for the trackers of the pickers whose p_i reaches
-// association_min_candidate_probability (Observation::candidate_pickers; none: not published at all). Before the first
-// sighting the bias prior is wide (sqrt(offset_std^2 + drift_std^2) = 3.2 m per axis), so only a detection that
-// is both near the fix and far from every other picker is identified; once identified, the corrected fix is
-// sharp and the next sightings follow.
+// association_min_candidate_probability (Observation::candidate_pickers; none: not published at all). Before
+// the first sighting the bias prior is wide (sqrt(offset_std^2 + drift_std^2) = 3.2 m per axis), so only a
+// detection that is both near the fix and far from every other picker is identified; once identified, the
+// corrected fix is sharp and the next sightings follow.
 #pragma once
 
 #include <deque>
@@ -69,7 +70,7 @@ std::vector<BeliefView> beliefViews(const std::vector<BeliefHistory>& histories,
 std::vector<BeliefView> beliefViews(const std::vector<const BeliefHistory*>& histories, double stamp,
                                     const PickerAssociationOptions& options);
 
-// Identity evidence for the association (issue "Find the lane" 2). An RFID read names its picker but puts it
+// Identity evidence for the association. An RFID read names its picker but puts it
 // only somewhere within ~5 m of the antenna, too coarse (and too correlated from read to read) to measure a
 // 1-2 m bias, but decisive about *who* a detection 1 m from the antenna is when the pickers' biased fixes are
 // 5 m apart: measured on the three-picker scenario, the true picker's tag had been read within 2 s before

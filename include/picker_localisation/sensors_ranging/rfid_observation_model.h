@@ -82,9 +82,10 @@ struct RfidModelOptions {
   int max_failed_attempts = 10;  // cap on m: the likelihood is taken at the antenna's pose of the read, and
                                  // the robot moves during a long gap (1 m/s: 5 m in the 10 attempts of 5 s)
 
-  // The keys of config/rfid_ranging.yaml (node-only keys accepted and ignored), as GnssIngestOptions::fromYaml.
+  // The model's keys of config/rfid_ranging.yaml (the node's own keys: RfidRangingNodeOptions).
   static RfidModelOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   static RfidModelOptions fromYamlFile(const std::string& path, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();
   std::string validate() const;  // "" or "<key> = <value>: must be ..." (fromYaml and the model's constructor call it)
 };
 

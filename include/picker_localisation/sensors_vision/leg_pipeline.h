@@ -46,14 +46,17 @@ struct LegPipelineOptions {
   double negative_range_max = 5.0;   // m
   double negative_clearance = 1.5;   // m, nodes this close to a person candidate or live track get none
 
-  // Reads the flat keys of config/vision.yaml's `leg_detector:` section (missing keys keep the defaults).
-  // Keys that only concern the node (topics, frames, timeouts) are accepted and ignored. `unknown`, when
-  // given, receives one message per key that is neither (naming the closest known key). Throws
-  // std::runtime_error naming the key on a bad value (type or range, see validate()).
+  // Reads the pipeline's keys of config/vision.yaml's `leg_detector:` section (missing keys keep the
+  // defaults; the node's own keys: LegDetectorNodeOptions). `unknown`, when given, receives one message per
+  // key that is not the pipeline's (naming the closest known key). Throws std::runtime_error naming the key
+  // on a bad value (type or range, see validate()).
   static LegPipelineOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
   // Applies the `leg_detector:` section of each file in order over `base` (later files win).
   static LegPipelineOptions fromYamlFiles(const std::vector<std::string>& files,
                                           std::vector<std::string>* unknown = nullptr);
+  // The `leg_detector:` sections of the files merged key by key, later files winning.
+  static YAML::Node mergedSections(const std::vector<std::string>& files);
+  static const std::vector<std::string>& yamlKeys();
   // Empty when valid, else the first problem: "<key> = <value>: must be ...".
   std::string validate() const;
 };
@@ -102,7 +105,7 @@ class LegPipeline {
                                          const CameraCones* camera = nullptr) {
     return track(source_frame, stamp, scanCandidates(scan, fixed_from_sensor), camera);
   }
-  // Negative information of one scan (issue "Find the lane": a robot that looks where the belief is and sees
+  // Negative information of one scan (a robot that looks where the belief is and sees
   // nobody must move the belief): an anonymous Observation listing EVERY map node, with
   //   L(n) = 1 - p_d(r_n)   at nodes whose cell the laser sees through (the beams towards every point of the
   //                          half-edges to its neighbours, and 0.5 m to either side, reach 0.3 m past them:

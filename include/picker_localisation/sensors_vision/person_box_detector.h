@@ -81,8 +81,8 @@ class OnnxPersonDetector : public PersonBoxDetector {
   std::shared_ptr<Impl> impl_;
 };
 
-// The camera_detector node's options: the `camera_detector:` section of config/vision.yaml, or the node's private
-// parameters (same keys). min_confidence applies to the detector in use (HOG default 0.3, ONNX 0.5).
+// The camera_detector node's options: the `camera_detector:` section of config/vision.yaml, or the node's
+// private parameters (same keys). min_confidence applies to the detector in use (default 0.5 for both).
 struct CameraDetectorOptions {
   std::string onnx_model;       // "" = OpenCV's HOG people detector, else an SSD-style ONNX file (OnnxOptions)
   HogOptions hog;               // keys hog_model, resize, hit_threshold, min_confidence, scale
