@@ -1,5 +1,7 @@
 # sensors_ranging tests: core gtests (no roscore), the GNSS bag test, rostests of the three nodes.
-pl_add_gtest(test_sensors_ranging test/test_sensors_ranging.cpp LIBS picker_localisation_sensors_ranging)
+pl_add_gtest(test_gnss test/test_gnss.cpp LIBS picker_localisation_sensors_ranging)
+pl_add_gtest(test_rfid test/test_rfid.cpp LIBS picker_localisation_sensors_ranging)
+pl_add_gtest(test_uwb test/test_uwb.cpp LIBS picker_localisation_sensors_ranging)
 pl_add_gtest(test_gnss_fleet test/test_gnss_fleet.cpp LIBS picker_localisation_sensors_ranging)
 pl_add_gtest(test_gnss_bag test/test_gnss_bag.cpp LIBS picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_gnss_ingest_node test/gnss_ingest.test test/test_gnss_ingest_node.cpp)

@@ -1,5 +1,6 @@
 # Topological Particle Filter tests (ROS-free gtests).
 pl_add_gtest(test_tpf test/test_tpf.cpp LIBS picker_localisation_tpf)
+pl_add_gtest(test_tpf_paper test/test_tpf_paper.cpp LIBS picker_localisation_tpf)
 pl_add_gtest(test_tracker_fleet test/test_tracker_fleet.cpp LIBS picker_localisation_tpf)
 
 # rostest: three trackers started from a pickers file by launch/trackers.launch.
