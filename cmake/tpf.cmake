@@ -17,7 +17,7 @@ if(benchmark_FOUND)
 endif()
 
 # ROS adapter and the tpf_tracker node (every picker of a farm in one process, one TPF each).
-add_library(picker_localisation_tpf_ros src/ros/tpf_tracker_node.cpp)
+add_library(picker_localisation_tpf_ros src/ros/tpf_tracker_node.cpp src/ros/belief_conversions.cpp)
 target_link_libraries(picker_localisation_tpf_ros PUBLIC picker_localisation_ros picker_localisation_tpf)
 add_dependencies(picker_localisation_tpf_ros ${PROJECT_NAME}_generate_messages_cpp)
 install(TARGETS picker_localisation_tpf_ros ARCHIVE DESTINATION ${CATKIN_PACKAGE_LIB_DESTINATION}

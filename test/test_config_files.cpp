@@ -17,6 +17,8 @@
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/dispatch/dispatcher_node_options.h"
 #include "picker_localisation/nbs/nbs_planner_node_options.h"
+#include "picker_localisation/ros/evaluator_node.h"
+#include "picker_localisation/ros/farm_sim_node.h"
 #include "picker_localisation/sensors_ranging/ranging_node_options.h"
 #include "picker_localisation/sensors_ranging/rfid_observation_model.h"
 #include "picker_localisation/sensors_ranging/uwb_ranging.h"
@@ -180,6 +182,8 @@ std::vector<NodeReference> nodeReferences() {
       {"dispatcher", "dispatch.md", "## The `dispatcher` node", dispatch::DispatcherNodeOptions::yamlKeys(),
        "dispatcher.yaml"},
       {"topological_map_server", "intro.md", "### topological_map_server", map_server, ""},
+      {"farm_sim", "sim.md", "## Node `farm_sim`", ros_adapter::FarmSimOptions::yamlKeys(), ""},
+      {"evaluator", "eval.md", "## Node `evaluator`", ros_adapter::EvaluatorOptions::yamlKeys(), ""},
       {"every node", "robot.md", "## Parameters every node shares", core::CommonNodeOptions::yamlKeys(), ""},
   };
 }

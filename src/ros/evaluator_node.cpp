@@ -15,6 +15,13 @@
 namespace picker_localisation {
 namespace ros_adapter {
 
+const std::vector<std::string>& EvaluatorOptions::yamlKeys() {
+  static const std::vector<std::string> keys{
+      "pickers_file",       "sample_rate",      "duration", "output_csv", "ordering_latency",
+      "max_truth_distance", "max_future_stamp", "map_file", "map_topic",  "belief_topic"};
+  return keys;
+}
+
 EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
   EvaluatorOptions o;
   if (!y || !y.IsMap()) return o;
@@ -29,10 +36,7 @@ EvaluatorOptions EvaluatorOptions::fromYaml(const YAML::Node& y, std::vector<std
   core::readOption(y, c, "belief_topic", o.belief_topic);
   core::readOption(y, c, "map_file", o.map_file);
   core::readOption(y, c, "map_topic", o.map_topic);
-  static const std::vector<std::string> known{
-      "pickers_file",       "sample_rate",      "duration", "output_csv", "ordering_latency",
-      "max_truth_distance", "max_future_stamp", "map_file", "map_topic",  "belief_topic"};
-  return core::checkOptions(o, y, known, c, unknown);
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
 }
 
 std::string EvaluatorOptions::validate() const {

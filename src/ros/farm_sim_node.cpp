@@ -82,6 +82,39 @@ void readOptional(const YAML::Node& y, const char* key, std::optional<T>& out) {
 }
 }  // namespace
 
+const std::vector<std::string>& FarmSimOptions::yamlKeys() {
+  static const std::vector<std::string> keys{"sim_config",
+                                             "urdf_template",
+                                             "pickers_file",
+                                             "datum_file",
+                                             "datum_source",
+                                             "seed",
+                                             "robots",
+                                             "robot_speed",
+                                             "patrol",
+                                             "enable_gnss",
+                                             "enable_laser",
+                                             "enable_rfid",
+                                             "enable_uwb",
+                                             "enable_camera",
+                                             "rate_factor",
+                                             "duration",
+                                             "clock_step",
+                                             "start_time",
+                                             "start_delay",
+                                             "ground_truth_rate",
+                                             "publish_sensor_frames",
+                                             "map_frame",
+                                             "map_file",
+                                             "map_topic",
+                                             "map_timeout",
+                                             "calls",
+                                             "tray_time_mean",
+                                             "calls_topic",
+                                             "call_status_topic"};
+  return keys;
+}
+
 FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::string>* unknown) {
   FarmSimOptions o;
   if (!y || !y.IsMap()) return o;
@@ -112,36 +145,7 @@ FarmSimOptions FarmSimOptions::fromYaml(const YAML::Node& y, std::vector<std::st
   core::readOption(y, c, "ground_truth_rate", o.ground_truth_rate);
   core::readOption(y, c, "publish_sensor_frames", o.publish_sensor_frames);
   core::readOption(y, c, "map_frame", o.map_frame);
-  static const std::vector<std::string> known{"sim_config",
-                                              "urdf_template",
-                                              "pickers_file",
-                                              "datum_file",
-                                              "datum_source",
-                                              "seed",
-                                              "robots",
-                                              "robot_speed",
-                                              "patrol",
-                                              "enable_gnss",
-                                              "enable_laser",
-                                              "enable_rfid",
-                                              "enable_uwb",
-                                              "enable_camera",
-                                              "rate_factor",
-                                              "duration",
-                                              "clock_step",
-                                              "start_time",
-                                              "start_delay",
-                                              "ground_truth_rate",
-                                              "publish_sensor_frames",
-                                              "map_frame",
-                                              "map_file",
-                                              "map_topic",
-                                              "map_timeout",
-                                              "calls",
-                                              "tray_time_mean",
-                                              "calls_topic",
-                                              "call_status_topic"};
-  return core::checkOptions(o, y, known, c, unknown);
+  return core::checkOptions(o, y, yamlKeys(), c, unknown);
 }
 
 std::string FarmSimOptions::validate() const {

@@ -53,6 +53,7 @@ struct EvaluatorOptions {
   // A bad value throws std::runtime_error "evaluator: <key> = <value>: must be ..."; an unknown key goes to
   // *unknown with the closest known one.
   static EvaluatorOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();  // every key fromYaml reads (its page's table)
   std::string validate() const;
 };
 

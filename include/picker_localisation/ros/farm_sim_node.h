@@ -55,6 +55,7 @@ struct FarmSimOptions {
   // A bad value throws std::runtime_error "farm_sim: <key> = <value>: must be ..."; an unknown key goes to
   // *unknown with the closest known one.
   static FarmSimOptions fromYaml(const YAML::Node& node, std::vector<std::string>* unknown = nullptr);
+  static const std::vector<std::string>& yamlKeys();  // every key fromYaml reads (its page's table)
   std::string validate() const;
   // The overrides applied to a configuration loaded from ~sim_config (throws on a bad ~patrol).
   void applyOverrides(sim::SimConfig& config) const;

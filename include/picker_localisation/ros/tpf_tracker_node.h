@@ -67,6 +67,7 @@
 
 #include "picker_localisation/core/picker_registry.h"
 #include "picker_localisation/core/stamp_ordered_buffer.h"
+#include "picker_localisation/ros/belief_conversions.h"
 #include "picker_localisation/ros/last_value_publisher.h"
 #include "picker_localisation/ros/map_source.h"
 #include "picker_localisation/ros/stamp_guard.h"
@@ -75,15 +76,6 @@
 
 namespace picker_localisation {
 namespace ros_adapter {
-
-// Messages from a filter's belief (frame_id: map frame).
-picker_localisation::PickerBelief toBeliefMsg(const tpf::Belief& belief, const topology::TopologicalMap& map,
-                                              const std::string& picker_id, const std::string& frame_id);
-geometry_msgs::PoseWithCovarianceStamped toEstimateMsg(const tpf::Belief& belief,
-                                                       const topology::TopologicalMap& map,
-                                                       const std::string& frame_id);
-visualization_msgs::MarkerArray toMarkers(const tpf::Belief& belief, const topology::TopologicalMap& map,
-                                          const std::string& picker_id, const std::string& frame_id);
 
 // The merged TPF parameters YAML of a private namespace: ~tpf_params_file (when set) as the base, then every
 // private parameter on top. Throws std::runtime_error naming the file on a YAML error.
