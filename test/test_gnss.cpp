@@ -25,30 +25,12 @@ using picker_localisation::core::DatumConfig;
 using picker_localisation::core::GeodeticDatum;
 using topology::NodeIndex;
 
-namespace {
-
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
+using ranging_test::kNaN;
 using ranging_test::latticeMap;
-
-double likelihoodAt(const core::Observation& obs, NodeIndex n) {
-  auto it = std::find(obs.nodes.begin(), obs.nodes.end(), n);
-  return it == obs.nodes.end() ? 0.0 : obs.likelihood[static_cast<std::size_t>(it - obs.nodes.begin())];
-}
-
-NodeIndex nodeAt(const topology::TopologicalMap& map, double x, double y) {
-  return map.nearestNode(Eigen::Vector2d(x, y));
-}
-
-DatumConfig riseholmeDatum(double heading_deg = 0.0) {
-  DatumConfig c;
-  c.latitude = 53.268;
-  c.longitude = -0.524;
-  c.heading = heading_deg * M_PI / 180.0;
-  return c;
-}
-
-}  // namespace
+using ranging_test::likelihoodAt;
+using ranging_test::nodeAt;
+using ranging_test::riseholmeDatum;
+using ranging_test::twoPickers;
 // ---------------------------------------------------------------------------------------------------------
 // Datum
 

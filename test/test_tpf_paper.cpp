@@ -10,6 +10,7 @@
 #include "picker_localisation/topology/map_io.h"
 #include "picker_localisation/topology/synthetic_map.h"
 #include "picker_localisation/tpf/topological_particle_filter.h"
+#include "tpf_test_util.h"
 
 using namespace picker_localisation;
 using topology::NodeIndex;
@@ -17,63 +18,12 @@ using tpf::Particle;
 using tpf::TopologicalParticleFilter;
 using tpf::TpfParams;
 using tpf::UpdateStatus;
-
-namespace {
-
-// Straight lane along +x: n nodes, `spacing` m apart, edges written one way (0 -> 1 -> ... -> n-1).
-std::shared_ptr<const topology::TopologicalMap> laneMap(std::size_t n = 5, double spacing = 3.0) {
-  std::vector<topology::Node> nodes(n);
-  std::vector<topology::EdgeSpec> edges;
-  for (std::size_t i = 0; i < n; ++i) {
-    nodes[i].name = "n" + std::to_string(i);
-    nodes[i].position = Eigen::Vector3d(spacing * static_cast<double>(i), 0.0, 0.0);
-    if (i > 0) edges.push_back({"e" + std::to_string(i), nodes[i - 1].name, nodes[i].name, "move_base"});
-  }
-  return std::make_shared<const topology::TopologicalMap>(
-      topology::TopologicalMap::build("lane", std::move(nodes), edges));
-}
-
-std::shared_ptr<const topology::TopologicalMap> polytunnel() {
-  return std::make_shared<const topology::TopologicalMap>(
-      topology::makePolytunnelMap(topology::PolytunnelSpec()));
-}
-
-core::Observation obsAt(double stamp, std::vector<NodeIndex> nodes, std::vector<double> l,
-                        bool identifying = true, const std::string& sensor = "gnss") {
-  core::Observation o;
-  o.stamp = stamp;
-  o.sensor = sensor;
-  o.identifying = identifying;
-  o.picker_id = identifying ? "picker_1" : "";
-  o.nodes = std::move(nodes);
-  o.likelihood = std::move(l);
-  return o;
-}
-
-// A filter whose particles never move by themselves: no velocity, no noise, no unconnected jumps.
-// The paper's filter read literally (the equation and Algorithm 1 tests check the paper's numbers); the
-// product's defaults depart from it (TpfParams, docs/readme/tpf.md) and are tested on their own below.
-TpfParams paperTpf() {
-  return TpfParams::presetForMethod("paper_tpf");
-}
-
-TpfParams staticParams(std::size_t particles = 2000) {
-  TpfParams p = paperTpf();
-  p.num_particles = particles;
-  p.velocity_init_variance = 0.0;
-  p.velocity_noise_variance = 0.0;
-  p.dwell_noise_min = p.dwell_noise_max = 0.0;
-  p.unconnected_jump_probability = 0.0;
-  return p;
-}
-
-std::map<NodeIndex, double> nodeFractions(const std::vector<Particle>& particles) {
-  std::map<NodeIndex, double> f;
-  for (const auto& p : particles) f[p.node] += 1.0 / static_cast<double>(particles.size());
-  return f;
-}
-
-}  // namespace
+using tpf_test::laneMap;
+using tpf_test::nodeFractions;
+using tpf_test::obsAt;
+using tpf_test::paperTpf;
+using tpf_test::polytunnel;
+using tpf_test::staticParams;
 
 // ------------------------------------------------------------------------------------------ Eqs. 2-7 ------
 TEST(TpfEquations, Eq6HalfJumpProbabilityAtHalfEdgeDwell) {

@@ -24,29 +24,12 @@ using picker_localisation::core::DatumConfig;
 using picker_localisation::core::GeodeticDatum;
 using topology::NodeIndex;
 
-namespace {
-
-const double kNaN = std::numeric_limits<double>::quiet_NaN();
-
+using ranging_test::kNaN;
 using ranging_test::latticeMap;
-
-double likelihoodAt(const core::Observation& obs, NodeIndex n) {
-  auto it = std::find(obs.nodes.begin(), obs.nodes.end(), n);
-  return it == obs.nodes.end() ? 0.0 : obs.likelihood[static_cast<std::size_t>(it - obs.nodes.begin())];
-}
-
-NodeIndex nodeAt(const topology::TopologicalMap& map, double x, double y) {
-  return map.nearestNode(Eigen::Vector2d(x, y));
-}
-
-core::PickerRegistry twoPickers() {
-  return core::PickerRegistry::parse(
-      "pickers:\n"
-      "  - {id: picker_1, gnss_topic: /pickers/picker_1/fix, rfid_tags: [rfid_1], uwb_tag: uwb_1}\n"
-      "  - {id: picker_2, gnss_topic: /pickers/picker_2/fix, rfid_tags: [rfid_2], uwb_tag: uwb_2}\n");
-}
-
-}  // namespace
+using ranging_test::likelihoodAt;
+using ranging_test::nodeAt;
+using ranging_test::riseholmeDatum;
+using ranging_test::twoPickers;
 // ---------------------------------------------------------------------------------------------------------
 // Range Histogram Filter
 
