@@ -25,12 +25,8 @@ using picker_localisation::core::DatumConfig;
 using picker_localisation::core::GeodeticDatum;
 using topology::NodeIndex;
 
-using ranging_test::kNaN;
-using ranging_test::latticeMap;
-using ranging_test::likelihoodAt;
-using ranging_test::nodeAt;
-using ranging_test::riseholmeDatum;
-using ranging_test::twoPickers;
+using namespace ranging_test;  // lattice maps, likelihoodAt, nodeAt, twoPickers, riseholmeDatum, kNaN
+
 // ---------------------------------------------------------------------------------------------------------
 // Datum
 

@@ -20,12 +20,7 @@ using tpf::Particle;
 using tpf::TopologicalParticleFilter;
 using tpf::TpfParams;
 using tpf::UpdateStatus;
-using tpf_test::laneMap;
-using tpf_test::nodeFractions;
-using tpf_test::obsAt;
-using tpf_test::paperTpf;
-using tpf_test::polytunnel;
-using tpf_test::staticParams;
+using namespace tpf_test;  // laneMap, polytunnel, obsAt, paperTpf, staticParams, nodeFractions
 
 // ------------------------------------------------------------------------------------------ bad input ------
 TEST(TpfBadInput, RejectedObservationsLeaveTheBeliefUntouched) {
