@@ -3,7 +3,7 @@
 # runner, against the node nearest the raw fix -- per variant and per picker. A belief must never be worse than no
 # filter: per variant the mean right-lane share of gnss_tpf >= raw_fix's and its mean topological error <=, and no
 # picker more than 0.2 below its own raw fix's lane share. Seeded: a run repeats exactly.
-# Usage: scripts/bench_lane_variants.sh [RUNS=8] [DURATION=900] [WORK_DIR]
+# Usage: scripts/bench_lane_variants.sh [RUNS=16] [DURATION=900] [WORK_DIR]
 # Environment: BUILD_DIR (default build), TPF_CONFIG (default config/tpf.yaml), METHODS (raw_fix,khan_connected,gnss_tpf),
 #   VARIANTS (space-separated names of the list below; default all),
 #   GRAPH_VARIANTS (space-separated names): these variants also go through the ROS graph, seed 1
@@ -22,7 +22,7 @@
 #           out_and_back each lane walked to its far end and back by the same lane, turning back twice as often
 set -eo pipefail
 cd "$(dirname "$0")/.."
-RUNS="${1:-8}"
+RUNS="${1:-16}"
 DURATION="${2:-900}"
 WORK="${3:-$(mktemp -d)}"
 BUILD_DIR="${BUILD_DIR:-build}"

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -851,13 +852,22 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
   std::vector<double>& mass = node_scratch_b_;
   touched_.clear();
   double total = 0.0;
+  auto deposit = [&](NodeIndex n, double w) {
+    if (!(w > 0.0)) return;  // a share that underflowed: the node is listed once, with a positive mass
+    if (mass[n] == 0.0) touched_.push_back(n);
+    mass[n] += w;
+  };
+  // TpfParams::lane_masses_by_swap_prior: the Eq. 9 masses Rao-Blackwellised over the lane swap.
+  const SwapPrior lane_prior =
+      bias_state && params_.lane_masses_by_swap_prior && swapsRun(obs) ? swapPrior() : SwapPrior{};
   auto accumulate = [&](std::size_t i, NodeIndex n, double w) {
     weights_[i] = w;
     total += w;
-    if (w > 0.0) {
-      if (mass[n] == 0.0) touched_.push_back(n);
-      mass[n] += w;
-    }
+    if (!(w > 0.0)) return;
+    if (lane_prior.known())
+      shareOverLanes(particles_[i], w, lane_prior, deposit);
+    else
+      deposit(n, w);
   };
   if (!velocity_term) {
     for (std::size_t i = 0; i < particles_.size(); ++i) {
@@ -996,11 +1006,7 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
   // where they are staggered it is nearly so.
   // The device prior is the fix's own: weighWithBiasState() stored it for this observation.
   const SwapPrior prior = swapPrior();
-  if (graph_->across.empty() || bias_step_ <= 0.0 || !prior.known()) return;
-  // Another sensor (a robot's LiDAR, RFID, UWB) told the lane recently: that evidence is not in the bias path
-  // the acceptance weighs, so swaps would undo it (measured: Table II rows with robot sensing lost
-  // 0.08-0.10).
-  if (obs.stamp - other_sensor_stamp_ < params_.lane_swap_memory) return;
+  if (bias_step_ <= 0.0 || !swapsRun(obs)) return;
   const double propose = -std::expm1(-params_.lane_swap_rate * bias_step_);
   if (!(propose > 0.0)) return;
   std::geometric_distribution<std::size_t> gap(std::min(propose, 1.0));
@@ -1014,6 +1020,63 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
     if (log_ratio < 0.0 && uniform01(rng_) >= std::exp(log_ratio)) continue;
     applySwap(p, to, shift);
   }
+}
+
+bool TopologicalParticleFilter::swapsRun(const core::Observation& obs) const {
+  if (graph_->across.empty() || !(params_.lane_swap_rate > 0.0) || !(bias_prior_variance_ > 1e-6))
+    return false;
+  // Another sensor (a robot's LiDAR, RFID, UWB) told the lane recently: that evidence is not in the bias path
+  // the acceptance weighs, so swaps would undo it (measured: Table II rows with robot sensing lost
+  // 0.08-0.10).
+  return !(obs.stamp - other_sensor_stamp_ < params_.lane_swap_memory);
+}
+
+template <typename Deposit>
+void TopologicalParticleFilter::shareOverLanes(const Particle& p, double weight, const SwapPrior& prior,
+                                               Deposit&& deposit) const {
+  // Rao-Blackwellisation over the lane (TpfParams::lane_masses_by_swap_prior): given the particle's
+  // along-lane place and its bias path, the same walk in any other lane explains every fix alike (its bias
+  // shifted by the lanes' offset), so the conditional law of its lane is the device prior's density of each
+  // shifted bias and path, normalised over the lanes across from it. The expected mass replaces the
+  // particle's draw of it. Every lane across counts, not only the adjacent ones: with the adjacent ones only,
+  // a middle lane gathers mass from both sides and an outer lane from one, and the decision leaned inwards
+  // (measured).
+  const NodeIndex n = p.node;
+  if (p.lane_change != 0 || p.bias_variance < 0.0f) {
+    deposit(n, weight);
+    return;
+  }
+  constexpr int kMaxLanesPerSide = 12;
+  constexpr double kNegligibleLogRatio = -12.0;
+  std::array<std::pair<NodeIndex, double>, 2 * kMaxLanesPerSide> across_lanes;
+  std::size_t count = 0;
+  double sum = 1.0;
+  const Eigen::Vector2d here = map_->position2d(n);
+  for (int side = 0; side < 2; ++side) {
+    NodeIndex previous = n, current = graph_->across[2 * n + side];
+    for (int k = 0; k < kMaxLanesPerSide && current != topology::kInvalidNode; ++k) {
+      const Eigen::Vector2d at = map_->position2d(current);
+      const double log_ratio = swapLogPriorRatio(p, here - at, prior);
+      if (log_ratio < kNegligibleLogRatio && k > 0) break;
+      const double ratio = std::exp(std::min(log_ratio, 50.0));
+      across_lanes[count++] = {current, ratio};
+      sum += ratio;
+      // The next lane in the same direction: the neighbour of `current` away from `previous`.
+      const Eigen::Vector2d step = at - map_->position2d(previous);
+      NodeIndex next = topology::kInvalidNode;
+      for (int s = 0; s < 2; ++s) {
+        const NodeIndex candidate = graph_->across[2 * current + s];
+        if (candidate != topology::kInvalidNode && candidate != previous &&
+            (map_->position2d(candidate) - at).dot(step) > 0.0)
+          next = candidate;
+      }
+      previous = current;
+      current = next;
+    }
+  }
+  const double scale = weight / sum;
+  deposit(n, scale);
+  for (std::size_t k = 0; k < count; ++k) deposit(across_lanes[k].first, scale * across_lanes[k].second);
 }
 
 TopologicalParticleFilter::SwapPrior TopologicalParticleFilter::swapPrior() const {

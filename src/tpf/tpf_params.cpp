@@ -193,6 +193,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "lane_evidence_sensors",
                                                 "lane_evidence_sweeps",
                                                 "map_node_by_lane",
+                                                "lane_masses_by_swap_prior",
                                                 "resampling",
                                                 "motion_model",
                                                 "sensor_gammas",
@@ -265,6 +266,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "lane_evidence_sensors", p.lane_evidence_sensors);
   read(node, "lane_evidence_sweeps", p.lane_evidence_sweeps);
   read(node, "map_node_by_lane", p.map_node_by_lane);
+  read(node, "lane_masses_by_swap_prior", p.lane_masses_by_swap_prior);
   if (node["method"]) {  // mode switches win
     try {
       p = presetForMethod(node["method"].as<std::string>(), p);
