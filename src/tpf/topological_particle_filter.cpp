@@ -1006,7 +1006,7 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
   // where they are staggered it is nearly so.
   // The device prior is the fix's own: weighWithBiasState() stored it for this observation.
   const SwapPrior prior = swapPrior();
-  if (bias_step_ <= 0.0 || !swapsRun(obs)) return;
+  if (bias_step_ <= 0.0 || !prior.known() || !swapsRun(obs)) return;
   const double propose = -std::expm1(-params_.lane_swap_rate * bias_step_);
   if (!(propose > 0.0)) return;
   std::geometric_distribution<std::size_t> gap(std::min(propose, 1.0));
@@ -1023,8 +1023,7 @@ void TopologicalParticleFilter::swapLanes(const core::Observation& obs) {
 }
 
 bool TopologicalParticleFilter::swapsRun(const core::Observation& obs) const {
-  if (graph_->across.empty() || !(params_.lane_swap_rate > 0.0) || !(bias_prior_variance_ > 1e-6))
-    return false;
+  if (graph_->across.empty() || !(params_.lane_swap_rate > 0.0)) return false;
   // Another sensor (a robot's LiDAR, RFID, UWB) told the lane recently: that evidence is not in the bias path
   // the acceptance weighs, so swaps would undo it (measured: Table II rows with robot sensing lost
   // 0.08-0.10).

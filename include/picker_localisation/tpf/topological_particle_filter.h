@@ -230,8 +230,9 @@ class TopologicalParticleFilter {
   SwapPrior swapPrior() const;
   // log of the device prior's density ratio for shifting a particle's bias (and its recent path) by `shift`.
   double swapLogPriorRatio(const Particle& p, const Eigen::Vector2d& shift, const SwapPrior& prior) const;
-  // True when this GNSS fix may run the lane swaps: the map has adjacent lanes, lane_swap_rate > 0, a device
-  // prior is known and no other sensor observed the picker within lane_swap_memory.
+  // True when this GNSS fix may run the lane swaps: the map has adjacent lanes, lane_swap_rate > 0 and no
+  // other sensor observed the picker within lane_swap_memory (the device prior, swapPrior().known(), is the
+  // caller's to check).
   bool swapsRun(const core::Observation& obs) const;
   // Gives `weight` to p's node and to the nodes across from it in the other lanes, in proportion to the
   // device prior's density of each shifted bias and path (TpfParams::lane_masses_by_swap_prior);
