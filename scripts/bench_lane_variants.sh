@@ -4,7 +4,8 @@
 # filter: per variant the mean right-lane share of gnss_tpf >= raw_fix's and its mean topological error <=, and no
 # picker more than 0.2 below its own raw fix's lane share. Seeded: a run repeats exactly.
 # Usage: scripts/bench_lane_variants.sh [RUNS=16] [DURATION=900] [WORK_DIR]
-# Environment: BUILD_DIR (default build), TPF_CONFIG (default config/tpf.yaml), METHODS (raw_fix,khan_connected,gnss_tpf),
+# Environment: SEED (first seed, default 1; runs take SEED..SEED+RUNS-1: SEED=17 gives the held-out seeds 17..32 on
+#   which no default was chosen), BUILD_DIR (default build), TPF_CONFIG (default config/tpf.yaml), METHODS (raw_fix,khan_connected,gnss_tpf),
 #   VARIANTS (space-separated names of the list below; default all),
 #   GRAPH_VARIANTS (space-separated names): these variants also go through the ROS graph, seed 1
 #   (scripts/bench_gnss_replay.sh: farm_sim recorded to a bag, replayed through gnss_ingest -> tpf_tracker ->
@@ -28,6 +29,7 @@ WORK="${3:-$(mktemp -d)}"
 BUILD_DIR="${BUILD_DIR:-build}"
 TPF_CONFIG="${TPF_CONFIG:-config/tpf.yaml}"
 METHODS="${METHODS:-raw_fix,khan_connected,gnss_tpf}"
+SEED="${SEED:-1}"
 mkdir -p "$WORK"
 python3 scripts/make_polytunnel_map.py "$WORK/two_tunnels.tmap2" 12 46 1.5 3.0 --tunnels 2 --rotation-deg 23 \
   --untagged --name two_tunnels > /dev/null
@@ -64,7 +66,7 @@ for v in $ALL; do
   if [ -n "$VARIANTS" ] && ! [[ " $VARIANTS " == *" $name "* ]]; then continue; fi
   sim="$(sim_variant "$name" "$error" "$walk")"
   "$BUILD_DIR/devel/lib/picker_localisation/experiment" --map "$WORK/$farm.tmap2" --scenario multi --runs "$RUNS" \
-    --seed 1 --duration "$DURATION" --methods "$METHODS" --sim-config "$sim" --tpf-config "$TPF_CONFIG" \
+    --seed "$SEED" --duration "$DURATION" --methods "$METHODS" --sim-config "$sim" --tpf-config "$TPF_CONFIG" \
     --out "$WORK/$name" --jobs 2 > "$WORK/$name.log" 2>&1 || { echo "experiment failed: $WORK/$name.log" >&2; exit 1; }
 done
 python3 scripts/lane_share_report.py "$WORK" "$METHODS"

@@ -719,6 +719,25 @@ TEST(TpfDecision, MapNodeByLaneFirst) {
   };
   EXPECT_EQ(decide(false), d);
   EXPECT_EQ(decide(true), b);
+
+  // Coarse to fine: a picker stopped just inside a lane, the lane unknown. Lanes 4, 5 and 6 hold 0.2 each at
+  // their first node, the headland node H5 0.4: heavier than any one lane, lighter than the lanes together.
+  // The picker is in a lane, so the decision is a lane's node (lane 5's by the likelihood's small
+  // preference); comparing H5 with each lane had named the headland.
+  const NodeIndex l4 = *map->index("r4_0"), l5 = *map->index("r5_0"), l6 = *map->index("r6_0"),
+                  head = *map->index("H5");
+  TpfParams p = staticParams(20000);
+  p.map_node_by_lane = true;
+  TopologicalParticleFilter f(map, p, 11);
+  ASSERT_TRUE(f.update(obsAt(0.0, {l4, l5, l6, head}, {1.0, 1.0, 1.0, 1.0})).ok());
+  ASSERT_TRUE(f.update(obsAt(0.0, {l4, l5, l6, head}, {0.19, 0.22, 0.19, 0.4})).ok());
+  EXPECT_NEAR(f.belief().massOf(head), 0.4, 0.02);
+  EXPECT_EQ(f.belief().map_node, l5);
+  // With the headland holding more than the lanes together, the headland node is named.
+  TopologicalParticleFilter g(map, p, 11);
+  ASSERT_TRUE(g.update(obsAt(0.0, {l4, l5, l6, head}, {1.0, 1.0, 1.0, 1.0})).ok());
+  ASSERT_TRUE(g.update(obsAt(0.0, {l4, l5, l6, head}, {0.1, 0.12, 0.1, 0.68})).ok());
+  EXPECT_EQ(g.belief().map_node, head);
   // The shipped defaults decide by lane; the paper's and Khan's presets follow Eq. 10.
   EXPECT_TRUE(TpfParams().map_node_by_lane);
   EXPECT_FALSE(TpfParams::presetForMethod("paper_tpf").map_node_by_lane);

@@ -1232,33 +1232,44 @@ void TopologicalParticleFilter::recordBelief(bool counted) {
 }
 
 void TopologicalParticleFilter::chooseMapNodeByLane() {
-  // TpfParams::map_node_by_lane: the lane of most mass, then its node of most mass; a node in no lane is a
-  // group of its own. Ties go to the lowest node index (as Eq. 10 here). O(support).
+  // TpfParams::map_node_by_lane, coarse to fine: in a lane or not (the totals), then the lane of most mass
+  // and its node of most mass, or else the off-lane node of most mass. Comparing one off-lane node with each
+  // lane instead favoured a headland node whenever the lanes' mass was spread over several lanes (GNSS only,
+  // the Rao-Blackwellised masses): a picker stopped a few metres into a lane was named in the headland. Ties
+  // go to the lowest node index (as Eq. 10 here). O(support).
   std::vector<double>& lane_mass = lane_scratch_;
   if (lane_mass.empty() || belief_.nodes.empty()) return;
+  double in_lanes = 0.0, off_lanes = 0.0;
   for (std::size_t k = 0; k < belief_.nodes.size(); ++k) {
     const topology::LaneIndex lane = map_->lane(belief_.nodes[k]);
-    if (lane >= 0) lane_mass[static_cast<std::size_t>(lane)] += belief_.masses[k];
+    if (lane >= 0) {
+      lane_mass[static_cast<std::size_t>(lane)] += belief_.masses[k];
+      in_lanes += belief_.masses[k];
+    } else {
+      off_lanes += belief_.masses[k];
+    }
   }
-  double best_group = -1.0;
   topology::LaneIndex best_lane = topology::kNoLane;
+  if (in_lanes >= off_lanes) {
+    double best_group = -1.0;
+    for (NodeIndex n : belief_.nodes) {
+      const topology::LaneIndex lane = map_->lane(n);
+      if (lane >= 0 && lane_mass[static_cast<std::size_t>(lane)] > best_group) {
+        best_group = lane_mass[static_cast<std::size_t>(lane)];
+        best_lane = lane;
+      }
+    }
+  }
+  const bool want_lane = best_lane >= 0;
+  double best = -1.0;
   NodeIndex best_node = belief_.map_node;
   for (std::size_t k = 0; k < belief_.nodes.size(); ++k) {
     const topology::LaneIndex lane = map_->lane(belief_.nodes[k]);
-    const double group = lane >= 0 ? lane_mass[static_cast<std::size_t>(lane)] : belief_.masses[k];
-    if (group > best_group) {
-      best_group = group;
-      best_lane = lane;
+    const bool candidate = want_lane ? lane == best_lane : lane < 0;
+    if (candidate && belief_.masses[k] > best) {
+      best = belief_.masses[k];
       best_node = belief_.nodes[k];
     }
-  }
-  if (best_lane >= 0) {
-    double best = -1.0;
-    for (std::size_t k = 0; k < belief_.nodes.size(); ++k)
-      if (map_->lane(belief_.nodes[k]) == best_lane && belief_.masses[k] > best) {
-        best = belief_.masses[k];
-        best_node = belief_.nodes[k];
-      }
   }
   for (NodeIndex n : belief_.nodes) {
     const topology::LaneIndex lane = map_->lane(n);
