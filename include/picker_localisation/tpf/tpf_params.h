@@ -145,11 +145,11 @@ struct TpfParams {
   std::vector<std::string> lane_evidence_sensors{"reported_row"};
   int lane_evidence_sweeps = 0;
   bool isLaneEvidence(const std::string& sensor) const;
-  // The decision (Eq. 10's n*, the tracker's current_node, a dispatch target) by lane first: the lane holding
-  // the most mass, then its node of most mass (a node in no lane competes on its own mass). Eq. 10 literally
-  // (false) takes the single node of most mass: where the belief is spread over a few lanes and many nodes
-  // along them (GNSS only), that node is a draw among near-equal ones and its lane changes with the particle
-  // noise, while the lanes' totals are stable.
+  // The decision (Eq. 10's n*, the tracker's current_node, a dispatch target) by lane first, coarse to fine:
+  // in a lane or not (the two totals), then the lane holding the most mass and its node of most mass, or else
+  // the off-lane node of most mass. Eq. 10 literally (false) takes the single node of most mass: where the
+  // belief is spread over a few lanes and many nodes along them (GNSS only), that node is a draw among
+  // near-equal ones and its lane changes with the particle noise, while the lanes' totals are stable.
   bool map_node_by_lane = true;
   // The belief's masses on a GNSS fix that runs the lane swaps, Rao-Blackwellised over the lane: each
   // particle in a lane shares its weight between its node and the nodes across from it in every other lane
