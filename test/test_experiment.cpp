@@ -303,6 +303,36 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
   EXPECT_DOUBLE_EQ(std::stod(oracle[4]), 1.0);
   EXPECT_LT(std::stod(oracle[5]), 0.2);
   EXPECT_GT(std::stod(raw[5]), std::stod(oracle[5]));  // the raw fix's node is often a lane off
+
+  // Per call, what the farm's tracker and the bias estimate said when a robot was assigned: masses are
+  // shares of one belief (the picker's lane holds at most the largest lane's), the picker's lane holds most
+  // of it in most calls (robots about), the last sighting is in the past.
+  std::ifstream calls(dir / "oracle" / "calls_0.csv");
+  std::string header;
+  std::getline(calls, header);
+  ASSERT_NE(header.find(",true_lane_mass,top_lane_mass,sighting_age_s,bias_residual_m,wrong_identities_600s"),
+            std::string::npos)
+      << header;
+  std::size_t assigned = 0, mostly_right = 0;
+  while (std::getline(calls, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    std::string cell;
+    while (std::getline(cs, cell, ',')) cells.push_back(cell);
+    ASSERT_EQ(cells.size(), 16u) << line;
+    const double true_lane = std::stod(cells[11]), top = std::stod(cells[12]), age = std::stod(cells[13]);
+    if (std::isnan(top)) continue;  // never assigned
+    ++assigned;
+    EXPECT_GE(top, 0.0);
+    EXPECT_LE(top, 1.0 + 1e-9);
+    if (!std::isnan(true_lane)) EXPECT_LE(true_lane, top + 1e-9) << line;
+    if (true_lane > 0.5) ++mostly_right;
+    EXPECT_GE(age, 0.0) << line;
+    const double residual = std::stod(cells[14]);
+    if (!std::isnan(residual)) EXPECT_GE(residual, 0.0) << line;
+  }
+  EXPECT_GE(assigned, 5u);
+  EXPECT_GT(mostly_right * 2, assigned);
 }
 
 TEST(Experiment, IdleRobotsArePositionedByThePlanner) {

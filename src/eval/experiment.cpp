@@ -290,6 +290,8 @@ class GraphRun {
     topology::LaneIndex inside = topology::kNoLane;  // the lane whose inner edge it drives along, if any
     Eigen::Vector2d robot_at = Eigen::Vector2d::Zero();
   };
+  // Scoring: the belief and bias estimate of a call's picker when its robot is assigned.
+  void recordCallPicker(OpenCall& c, double now);
   void publish(const core::Observation& obs);
   NodeIndex estimate(std::size_t picker) const;
   void arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by);  // scoring an arrival
@@ -311,6 +313,7 @@ class GraphRun {
   const MethodSpec& spec_;
   sim::FarmSimulator simulator_;
   std::vector<Scoring> scoring_;
+  std::vector<std::vector<double>> wrong_identity_stamps_;  // scoring: per picker, its wrong identities
   std::unique_ptr<sensors::GnssFleet> gnss_;
   std::unique_ptr<sensors::RfidObservationModel> rfid_;
   std::unique_ptr<vision::LegPipeline> legs_;
@@ -344,6 +347,7 @@ GraphRun::GraphRun(std::shared_ptr<const topology::TopologicalMap> map, const Ru
   for (std::size_t i = 0; i < n; ++i) {
     const sim::PickerSpec& ps = simulator_.pickerSpec(i);
     scoring_.push_back({ps.id});
+    wrong_identity_stamps_.emplace_back();
     gnss_->add(ps.id);
     registry_entries.push_back({ps.id, "", {ps.rfid_tag}, ps.uwb_tag, ""});
   }
@@ -499,7 +503,11 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
         const double d = (simulator_.pickerPose(j).position() - t.position).norm();
         if (d < best) best = d, nearest = j;
       }
-      if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) ++result_.wrong_identifications;
+      if (best < 1.0 && nearest != static_cast<std::size_t>(a.picker)) {
+        ++result_.wrong_identifications;
+        wrong_identity_stamps_[static_cast<std::size_t>(a.picker)].push_back(s.stamp);
+        wrong_identity_stamps_[nearest].push_back(s.stamp);
+      }
     }
     if (a.bias.accepted) {
       ++result_.bias_sightings;
@@ -579,6 +587,7 @@ void GraphRun::dispatchCalls(double now) {
       c.inside = map_->lane(c.robot_node);
       c.record.first_target_in_picker_lane =
           map_->lane(g.node) != topology::kNoLane && map_->lane(g.node) == simulator_.pickerLane(c.picker);
+      recordCallPicker(c, now);
     }
   }
   for (auto it = open_calls_.begin(); it != open_calls_.end();) {
@@ -614,6 +623,30 @@ void GraphRun::dispatchCalls(double now) {
       ++it;
     }
   }
+}
+
+void GraphRun::recordCallPicker(OpenCall& c, double now) {
+  CallRecord& r = c.record;
+  const std::string& id = r.picker_id;
+  const topology::LaneIndex lane = simulator_.pickerLane(c.picker);
+  if (trackers_) {
+    const tpf::Belief& b = trackers_->find(id)->filter->belief();
+    std::map<topology::LaneIndex, double> per_lane;
+    for (std::size_t k = 0; k < b.nodes.size(); ++k)
+      if (map_->lane(b.nodes[k]) != topology::kNoLane) per_lane[map_->lane(b.nodes[k])] += b.masses[k];
+    r.top_lane_mass = 0.0;
+    for (const auto& [l, m] : per_lane) r.top_lane_mass = std::max(r.top_lane_mass, m);
+    if (lane != topology::kNoLane) r.true_lane_mass = per_lane.count(lane) ? per_lane[lane] : 0.0;
+  }
+  const sensors::GnssBiasEstimator& bias = gnss_->find(id)->ingest.bias();
+  // The sighting may carry the step's own stamp, a rounding above `now`.
+  r.sighting_age_s =
+      bias.sighted() ? std::max(0.0, now - bias.lastSighting()) : std::numeric_limits<double>::infinity();
+  const Eigen::Vector2d& error = scoring_[c.picker].true_gnss_error;
+  if (error.allFinite()) r.bias_residual_m = (error - bias.applied(now)).norm();
+  const std::vector<double>& wrong = wrong_identity_stamps_[c.picker];
+  r.wrong_identities_600s = static_cast<std::size_t>(
+      std::count_if(wrong.begin(), wrong.end(), [&](double t) { return t <= now && t > now - 600.0; }));
 }
 
 void GraphRun::finish() {
@@ -919,12 +952,16 @@ std::vector<RunResult> runSeeds(const std::shared_ptr<const topology::Topologica
 void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::ofstream calls(dir / ("calls_" + std::to_string(k) + ".csv"));
-    calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
-             "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row\n";
+    calls
+        << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
+           "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row,true_lane_mass,top_lane_mass,"
+           "sighting_age_s,bias_residual_m,wrong_identities_600s\n";
     for (const CallRecord& c : runs[k].calls)
       calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
             << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
-            << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row << "\n";
+            << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row << ","
+            << c.true_lane_mass << "," << c.top_lane_mass << "," << c.sighting_age_s << ","
+            << c.bias_residual_m << "," << c.wrong_identities_600s << "\n";
   }
 }
 

@@ -17,6 +17,7 @@
 // with the reason; it is never run with a substitute.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <iosfwd>
 #include <memory>
@@ -104,6 +105,14 @@ struct CallRecord {
   std::string arrived_by;              // "rfid" or "lidar": the sensing that declared the arrival
   double metres = 0.0;                 // driven by the serving robot from assignment to arrival
   bool reported_row = false;           // the call carried a reported row
+  // What the picker's belief and bias estimate were when a robot was assigned (the farm's tracker, whatever
+  // the method tells the dispatcher): where wrong-lane entries come from.
+  double true_lane_mass = std::nan("");   // the belief's mass in the picker's true lane (NaN: not in a lane)
+  double top_lane_mass = std::nan("");    // the largest mass of any one lane
+  double sighting_age_s = std::nan("");   // s since the picker's last accepted bias sighting (+inf: never)
+  double bias_residual_m = std::nan("");  // m, |the unit's true error - the bias estimate applied|
+  std::size_t wrong_identities_600s = 0;  // LiDAR people given to or taken from this picker wrongly in the
+                                          // 600 s before the call (scoring only)
 };
 
 struct RunResult {
