@@ -296,6 +296,46 @@ TEST(GnssBiasEstimator, PriorIsStationaryUntilTheFirstSighting) {
   EXPECT_NEAR(b.covariance(100.0)(0, 1), 0.0, 1e-12);
 }
 
+TEST(GnssBiasEstimator, RestartsFromRefusedSightingsThatAgree) {
+  // A wrong identity first: a person 5 m off passes the wide prior's gate and the estimate settles there. The
+  // right sightings that follow fail the gate; three within 20 s that agree start the estimate again from
+  // the prior with them. Without the restart the estimate stays 5 m off.
+  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.09;
+  const Eigen::Vector2d wrong(5.0, 0.0), right(0.0, 0.5);
+  for (int restart : {3, 0}) {
+    GnssBiasOptions o;
+    o.restart_sightings = restart;
+    GnssBiasEstimator b(o);
+    for (int k = 0; k < 5; ++k) ASSERT_TRUE(b.update(k, wrong, R).accepted);
+    EXPECT_LT((b.bias(4.0) - wrong).norm(), 0.3);
+    EXPECT_FALSE(b.update(10.0, right, R).accepted);
+    EXPECT_FALSE(b.update(12.0, right, R).accepted);
+    const BiasUpdate third = b.update(14.0, right, R);
+    if (restart) {
+      EXPECT_TRUE(third.accepted) << third.reason;
+      EXPECT_NE(third.reason.find("restarted"), std::string::npos) << third.reason;
+      EXPECT_LT((b.bias(14.0) - right).norm(), 0.3);
+      EXPECT_EQ(b.restarts(), 1u);
+      EXPECT_TRUE(b.update(15.0, right, R).accepted);  // and the next right sighting passes the gate
+    } else {
+      EXPECT_FALSE(third.accepted);
+      EXPECT_LT((b.bias(14.0) - wrong).norm(), 0.5);
+      EXPECT_EQ(b.restarts(), 0u);
+    }
+  }
+  // Refused sightings that disagree, or that agree on a bias the prior itself refuses (40 m), or that are
+  // spread over more than the window, restart nothing.
+  GnssBiasEstimator b;
+  for (int k = 0; k < 5; ++k) ASSERT_TRUE(b.update(k, wrong, R).accepted);
+  EXPECT_FALSE(b.update(10.0, Eigen::Vector2d(-5.0, 0.0), R).accepted);
+  EXPECT_FALSE(b.update(11.0, Eigen::Vector2d(0.0, 6.0), R).accepted);
+  EXPECT_FALSE(b.update(12.0, Eigen::Vector2d(-5.0, 6.0), R).accepted);
+  for (double t : {20.0, 21.0, 22.0}) EXPECT_FALSE(b.update(t, Eigen::Vector2d(40.0, 0.0), R).accepted);
+  for (double t : {40.0, 70.0, 100.0}) EXPECT_FALSE(b.update(t, Eigen::Vector2d(-8.0, 0.0), R).accepted);
+  EXPECT_EQ(b.restarts(), 0u);
+  EXPECT_LT((b.bias(100.0) - wrong).norm(), 2.0);
+}
+
 TEST(GnssBiasEstimator, ConvergesOnAConstantBiasThenRelaxesToTheOffset) {
   GnssBiasEstimator b;
   std::mt19937_64 rng(7);

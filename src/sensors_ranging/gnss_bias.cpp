@@ -26,6 +26,8 @@ GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
   core::readOption(y, c, "bias_pairing_speed", o.pairing_speed);
   core::readOption(y, c, "bias_gate_sigmas", o.gate_sigmas);
   core::readOption(y, c, "bias_max_age", o.max_age);
+  core::readOption(y, c, "bias_restart_sightings", o.restart_sightings);
+  core::readOption(y, c, "bias_restart_window", o.restart_window);
   core::readOption(y, c, "bias_error_inflation", o.error_inflation);
   core::readOption(y, c, "bias_sighting_sensors", o.sighting_sensors);
   const std::string problem = o.validate();
@@ -35,8 +37,9 @@ GnssBiasOptions GnssBiasOptions::fromYaml(const YAML::Node& y) {
 
 const std::vector<std::string>& GnssBiasOptions::yamlKeys() {
   static const std::vector<std::string> keys = {
-      "estimate_bias",     "bias_offset_std",  "bias_drift_std",     "bias_drift_tau",   "bias_residual_std",
-      "bias_min_sigma",    "bias_pairing_gap", "bias_pairing_speed", "bias_gate_sigmas", "bias_max_age",
+      "estimate_bias",        "bias_offset_std",      "bias_drift_std",         "bias_drift_tau",
+      "bias_residual_std",    "bias_min_sigma",       "bias_pairing_gap",       "bias_pairing_speed",
+      "bias_gate_sigmas",     "bias_max_age",         "bias_restart_sightings", "bias_restart_window",
       "bias_error_inflation", "bias_sighting_sensors"};
   return keys;
 }
@@ -55,6 +58,9 @@ std::string GnssBiasOptions::validate() const {
     return bad("bias_pairing_speed", pairing_speed, "finite and >= 0");
   if (!positive(gate_sigmas)) return bad("bias_gate_sigmas", gate_sigmas, "finite and > 0");
   if (!(max_age > 0.0)) return bad("bias_max_age", max_age, "> 0");
+  if (restart_sightings < 0 || restart_sightings > 100)
+    return bad("bias_restart_sightings", restart_sightings, "in [0, 100]");
+  if (!positive(restart_window)) return bad("bias_restart_window", restart_window, "finite and > 0");
   if (!(error_inflation >= 1.0) || !std::isfinite(error_inflation))
     return bad("bias_error_inflation", error_inflation, "finite and >= 1");
   return "";
@@ -81,6 +87,8 @@ void GnssBiasEstimator::reset() {
   P_.bottomRightCorner<2, 2>() = Eigen::Matrix2d::Identity() * options_.drift_std * options_.drift_std;
   last_ = 0.0;
   sightings_ = refused_ = 0;
+  refused_recent_.clear();
+  restarts_ = 0;
 }
 
 // Exact OU transition of the drift states; the offset states are constant.
@@ -149,8 +157,25 @@ BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const E
     std::ostringstream s;
     s << "innovation " << u.innovation.norm() << " m fails the gate (Mahalanobis " << u.mahalanobis << " > "
       << options_.gate_sigmas << ")";
+    if (options_.restart_sightings > 0) {
+      refused_recent_.push_back({t, y, 0.5 * (R + R.transpose())});
+      const double since = t - options_.restart_window;
+      refused_recent_.erase(std::remove_if(refused_recent_.begin(), refused_recent_.end(),
+                                           [since](const Refused& r) { return r.t < since; }),
+                            refused_recent_.end());
+      if (restartFromRefused()) {
+        BiasUpdate restarted;
+        restarted.accepted = true;
+        restarted.innovation = u.innovation;
+        restarted.mahalanobis = u.mahalanobis;
+        restarted.reason =
+            "restarted from " + std::to_string(options_.restart_sightings) + " refused sightings that agree";
+        return restarted;
+      }
+    }
     return refuse(s.str());
   }
+  refused_recent_.clear();
   const Eigen::Matrix<double, 4, 2> K = P * H.transpose() * S_inv;
   x_ = x + K * u.innovation;
   // Joseph form keeps P symmetric positive definite.
@@ -160,6 +185,48 @@ BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const E
   ++sightings_;
   u.accepted = true;
   return u;
+}
+
+bool GnssBiasEstimator::restartFromRefused() {
+  const std::size_t need = static_cast<std::size_t>(options_.restart_sightings);
+  if (refused_recent_.size() < need) return false;
+  // The newest `need` refused sightings, each against the first of them: the drift may move the bias between
+  // the two (its variance growth over dt), and both are noisy.
+  const std::vector<Refused> group(refused_recent_.end() - static_cast<std::ptrdiff_t>(need),
+                                   refused_recent_.end());
+  const Refused& first = group.front();
+  for (const Refused& r : group) {
+    const Eigen::Matrix2d S =
+        first.R + r.R + Eigen::Matrix2d::Identity() * options_.driftRate() * std::max(0.0, r.t - first.t);
+    if (!(S.determinant() > 0.0)) return false;
+    const Eigen::Vector2d d = r.y - first.y;
+    if (std::sqrt(d.dot(S.inverse() * d)) > options_.gate_sigmas) return false;
+  }
+  // Replayed from the prior with restarts off (options_ copy): sightings the prior itself refuses (a bias
+  // no unit of this model has) leave the old estimate as it was.
+  const GnssBiasOptions options = options_;
+  const Eigen::Matrix<double, 4, 1> x = x_;
+  const Eigen::Matrix4d P = P_;
+  const double last = last_;
+  const std::size_t sightings = sightings_, refused = refused_, restarts = restarts_;
+  reset();
+  options_.restart_sightings = 0;
+  std::size_t accepted = 0;
+  for (const Refused& r : group) accepted += update(r.t, r.y, r.R).accepted;
+  options_ = options;
+  refused_recent_.clear();
+  refused_ = refused;
+  if (accepted < need) {  // not every one of them fits one bias from the prior: keep the old estimate
+    x_ = x;
+    P_ = P;
+    last_ = last;
+    sightings_ = sightings;
+    restarts_ = restarts;
+    return false;
+  }
+  sightings_ = sightings + accepted;
+  restarts_ = restarts + 1;
+  return true;
 }
 
 }  // namespace sensors

@@ -40,6 +40,14 @@ struct GnssBiasOptions {
   double pairing_speed = 1.0;  // m/s, picker motion between fix and sighting: adds (speed * gap)^2 to R
   double gate_sigmas = 3.5;    // a sighting whose innovation exceeds this Mahalanobis distance is refused
   double max_age = 600.0;      // s after the last sighting beyond which corrections stop (estimate = prior)
+  // Recovery from a wrong estimate. A LiDAR person given to the wrong picker can pass the gate while the
+  // estimate is still wide (the first sighting, or one after minutes unseen); the gate then refuses the right
+  // sightings that follow, and the estimate stays off by the distance between the two people. When
+  // restart_sightings refused sightings within restart_window s agree with each other (each within
+  // gate_sigmas of the first, with both covariances and the drift between them) and no sighting was accepted
+  // since the first of them, the estimate starts again from the prior with those sightings. 0: never.
+  int restart_sightings = 3;
+  double restart_window = 20.0;  // s
   // Every corrected fix carries the same estimate error, but the filter fuses fixes as independent: N fixes
   // would count that error N times too few. The estimate's covariance in a corrected fix's likelihood is
   // multiplied by this factor (1: as if independent).
@@ -92,6 +100,7 @@ class GnssBiasEstimator {
   double lastSighting() const { return last_; }
   std::size_t sightings() const { return sightings_; }
   std::size_t refused() const { return refused_; }
+  std::size_t restarts() const { return restarts_; }
   const GnssBiasOptions& options() const { return options_; }
   void reset();
 
@@ -102,6 +111,15 @@ class GnssBiasEstimator {
   Eigen::Matrix4d P_;
   double last_ = 0.0;
   std::size_t sightings_ = 0, refused_ = 0;
+  struct Refused {
+    double t;
+    Eigen::Vector2d y;
+    Eigen::Matrix2d R;
+  };
+  std::vector<Refused> refused_recent_;  // since the last accepted sighting, within restart_window
+  std::size_t restarts_ = 0;
+  // The refused sightings agree: start again from the prior with them (restart_sightings).
+  bool restartFromRefused();
 };
 
 }  // namespace sensors
