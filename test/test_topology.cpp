@@ -263,6 +263,18 @@ TEST(Lanes, RowTraversalRuleOnRiseholme) {
   EXPECT_EQ(m.laneNameOf(*m.index("dock_0")), "");
 }
 
+TEST(Lanes, MassPerLaneSumsASparseBelief) {
+  TopologicalMap m = loadMap(kTmap2);
+  const NodeIndex w1 = *m.index("WayPoint1"), w9 = *m.index("WayPoint9"), w10 = *m.index("WayPoint10");
+  const NodeIndex dock = *m.index("dock_0");
+  const auto per_lane = m.massPerLane({w1, w9, w10, dock}, {0.25, 0.25, 0.375, 0.125});
+  ASSERT_EQ(per_lane.size(), 3u);
+  EXPECT_DOUBLE_EQ(per_lane.at(m.lane(w1)), 0.5);  // WayPoint1 and WayPoint9 share a lane
+  EXPECT_DOUBLE_EQ(per_lane.at(m.lane(w10)), 0.375);
+  EXPECT_DOUBLE_EQ(per_lane.at(kNoLane), 0.125);
+  EXPECT_TRUE(m.massPerLane({}, {}).empty());
+}
+
 TEST(Lanes, TagRuleWinsAndChainRuleFallsBack) {
   TopologicalMap tagged = makePolytunnelMap(PolytunnelSpec{});
   EXPECT_EQ(tagged.numLanes(), 12u);

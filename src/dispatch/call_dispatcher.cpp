@@ -257,8 +257,7 @@ NodeIndex CallDispatcher::goalFor(Call& c, double now) const {
   const topology::LaneIndex lane = t == topology::kInvalidNode ? topology::kNoLane : map_->lane(t);
   if (lane == topology::kNoLane || options_.commit_share <= 0.0) return t;
   const Belief& b = beliefs_.at(c.picker_id);
-  std::map<topology::LaneIndex, double> lane_mass;
-  for (std::size_t k = 0; k < b.nodes.size(); ++k) lane_mass[map_->lane(b.nodes[k])] += b.masses[k];
+  std::map<topology::LaneIndex, double> lane_mass = map_->massPerLane(b.nodes, b.masses);
   const auto robot = robot_node_.find(c.robot_id);
   const bool in_target_lane =
       robot != robot_node_.end() && map_->lane(robot->second) == lane && !laneEnd(robot->second);

@@ -631,11 +631,10 @@ void GraphRun::recordCallPicker(OpenCall& c, double now) {
   const topology::LaneIndex lane = simulator_.pickerLane(c.picker);
   if (trackers_) {
     const tpf::Belief& b = trackers_->find(id)->filter->belief();
-    std::map<topology::LaneIndex, double> per_lane;
-    for (std::size_t k = 0; k < b.nodes.size(); ++k)
-      if (map_->lane(b.nodes[k]) != topology::kNoLane) per_lane[map_->lane(b.nodes[k])] += b.masses[k];
+    std::map<topology::LaneIndex, double> per_lane = map_->massPerLane(b.nodes, b.masses);
     r.top_lane_mass = 0.0;
-    for (const auto& [l, m] : per_lane) r.top_lane_mass = std::max(r.top_lane_mass, m);
+    for (const auto& [l, m] : per_lane)
+      if (l != topology::kNoLane) r.top_lane_mass = std::max(r.top_lane_mass, m);
     if (lane != topology::kNoLane) r.true_lane_mass = per_lane.count(lane) ? per_lane[lane] : 0.0;
   }
   const sensors::GnssBiasEstimator& bias = gnss_->find(id)->ingest.bias();

@@ -202,30 +202,19 @@ bool GnssBiasEstimator::restartFromRefused() {
     const Eigen::Vector2d d = r.y - first.y;
     if (std::sqrt(d.dot(S.inverse() * d)) > options_.gate_sigmas) return false;
   }
-  // Replayed from the prior with restarts off (options_ copy): sightings the prior itself refuses (a bias
-  // no unit of this model has) leave the old estimate as it was.
-  const GnssBiasOptions options = options_;
-  const Eigen::Matrix<double, 4, 1> x = x_;
-  const Eigen::Matrix4d P = P_;
-  const double last = last_;
-  const std::size_t sightings = sightings_, refused = refused_, restarts = restarts_;
-  reset();
-  options_.restart_sightings = 0;
-  std::size_t accepted = 0;
-  for (const Refused& r : group) accepted += update(r.t, r.y, r.R).accepted;
-  options_ = options;
+  // Replayed into a fresh estimate from the prior with restarts off: sightings the prior itself refuses (a
+  // bias no unit of this model has) leave the old estimate as it was.
   refused_recent_.clear();
-  refused_ = refused;
-  if (accepted < need) {  // not every one of them fits one bias from the prior: keep the old estimate
-    x_ = x;
-    P_ = P;
-    last_ = last;
-    sightings_ = sightings;
-    restarts_ = restarts;
-    return false;
-  }
-  sightings_ = sightings + accepted;
-  restarts_ = restarts + 1;
+  GnssBiasOptions replay_options = options_;
+  replay_options.restart_sightings = 0;
+  GnssBiasEstimator replay(replay_options);
+  for (const Refused& r : group) replay.update(r.t, r.y, r.R);
+  if (replay.sightings() < need) return false;  // not every one of them fits one bias from the prior
+  x_ = replay.x_;
+  P_ = replay.P_;
+  last_ = replay.last_;
+  sightings_ += replay.sightings();
+  ++restarts_;
   return true;
 }
 

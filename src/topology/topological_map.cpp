@@ -495,6 +495,13 @@ std::string TopologicalMap::laneNameOf(NodeIndex i) const {
   return l == kNoLane ? std::string() : laneName(l);
 }
 
+std::map<LaneIndex, double> TopologicalMap::massPerLane(const std::vector<NodeIndex>& nodes,
+                                                        const std::vector<double>& masses) const {
+  std::map<LaneIndex, double> per_lane;
+  for (std::size_t k = 0; k < nodes.size() && k < masses.size(); ++k) per_lane[lane(nodes[k])] += masses[k];
+  return per_lane;
+}
+
 std::string MapChange::summary() const {
   std::ostringstream s;
   s << "+" << added << " -" << removed << " nodes, " << moved << " moved";

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -174,6 +175,10 @@ class TopologicalMap {
   const std::vector<NodeIndex>& laneNodes(LaneIndex l) const { return lane_nodes_.at(static_cast<std::size_t>(l)); }
   // Name of a node's lane, or "" when it has none.
   std::string laneNameOf(NodeIndex i) const;
+  // A sparse belief's mass (masses[k] at nodes[k]) summed per lane; mass on nodes without a lane under
+  // kNoLane.
+  std::map<LaneIndex, double> massPerLane(const std::vector<NodeIndex>& nodes,
+                                          const std::vector<double>& masses) const;
 
   // Connected components of the undirected motion graph.
   std::size_t numComponents() const { return num_components_; }
