@@ -7,9 +7,10 @@
 # Environment: SEED (first seed, default 1; runs take SEED..SEED+RUNS-1: SEED=17 gives the held-out seeds 17..32 on
 #   which no default was chosen), BUILD_DIR (default build), TPF_CONFIG (default config/tpf.yaml), METHODS (raw_fix,khan_connected,gnss_tpf),
 #   VARIANTS (space-separated names of the list below; default all),
-#   GRAPH_VARIANTS (space-separated names): these variants also go through the ROS graph, seed 1
-#   (scripts/bench_gnss_replay.sh: farm_sim recorded to a bag, replayed through gnss_ingest -> tpf_tracker ->
-#   evaluator; ~5 min wall each), reported per picker as graph_tpf against the runner's raw_fix and gnss_tpf of seed 1.
+#   GRAPH_VARIANTS (space-separated names): these variants also go through the ROS graph, on each seed of
+#   GRAPH_SEEDS (space-separated, default "1"; scripts/bench_gnss_replay.sh: farm_sim recorded to a bag, replayed
+#   through gnss_ingest -> tpf_tracker -> evaluator; ~5 min wall per variant and seed), reported per picker as
+#   graph_tpf against the runner's raw_fix and gnss_tpf of the same seeds.
 # Variants (maps from scripts/make_polytunnel_map.py; sim configs are config/sim.yaml with these changes):
 #   farms:  two_tunnels  12 untagged lanes x 135 m, 1.5 m apart, two tunnels, rotated 23 deg
 #           narrow       8 tagged lanes x 60 m, 1.2 m apart
@@ -71,17 +72,23 @@ for v in $ALL; do
 done
 python3 scripts/lane_share_report.py "$WORK" "$METHODS"
 [ -n "$GRAPH_VARIANTS" ] || exit 0
+GRAPH_SEEDS="${GRAPH_SEEDS:-1}"
 for name in $GRAPH_VARIANTS; do
   farm="${name%%_*}"
   [ "$farm" = two ] && farm=two_tunnels
   [ -f "$WORK/sim_$name.yaml" ] || { echo "unknown variant $name (run it in the runner first)" >&2; exit 1; }
-  SIM_CONFIG="$WORK/sim_$name.yaml" scripts/bench_gnss_replay.sh "$WORK/$farm.tmap2" "$DURATION" 1 \
-    "$WORK/graph_run_$name" > "$WORK/graph_run_$name.json"
   for m in raw_fix gnss_tpf graph_tpf; do mkdir -p "$WORK/graph/$name/$m"; done
-  cp "$WORK/graph_run_$name/runner/raw_fix/run_0.csv" "$WORK/graph/$name/raw_fix/run_0.csv"
-  cp "$WORK/graph_run_$name/runner/gnss_tpf/run_0.csv" "$WORK/graph/$name/gnss_tpf/run_0.csv"
-  cp "$WORK/graph_run_$name/graph_errors.csv" "$WORK/graph/$name/graph_tpf/run_0.csv"
+  k=0
+  for seed in $GRAPH_SEEDS; do
+    run="$WORK/graph_run_${name}_seed$seed"
+    SIM_CONFIG="$WORK/sim_$name.yaml" scripts/bench_gnss_replay.sh "$WORK/$farm.tmap2" "$DURATION" "$seed" "$run" \
+      > "$run.json"
+    cp "$run/runner/raw_fix/run_0.csv" "$WORK/graph/$name/raw_fix/run_$k.csv"
+    cp "$run/runner/gnss_tpf/run_0.csv" "$WORK/graph/$name/gnss_tpf/run_$k.csv"
+    cp "$run/graph_errors.csv" "$WORK/graph/$name/graph_tpf/run_$k.csv"
+    k=$((k + 1))
+  done
 done
 echo
-echo "Through the ROS graph (seed 1):"
+echo "Through the ROS graph (seeds $GRAPH_SEEDS):"
 python3 scripts/lane_share_report.py "$WORK/graph" raw_fix,gnss_tpf,graph_tpf
