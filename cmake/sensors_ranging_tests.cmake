@@ -5,6 +5,8 @@ pl_add_gtest(test_uwb test/test_uwb.cpp LIBS picker_localisation_sensors_ranging
 pl_add_gtest(test_gnss_fleet test/test_gnss_fleet.cpp LIBS picker_localisation_sensors_ranging)
 pl_add_gtest(test_gnss_bag test/test_gnss_bag.cpp LIBS picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_gnss_ingest_node test/gnss_ingest.test test/test_gnss_ingest_node.cpp)
+# The same tests' joint association of one scan, with stamp ordering.
+add_rostest(test/gnss_ingest_ordered.test DEPENDENCIES test_gnss_ingest_node)
 target_link_libraries(test_gnss_ingest_node picker_localisation_sensors_ranging_ros)
 add_rostest_gtest(test_rfid_ranging_node test/rfid_ranging.test test/test_rfid_ranging_node.cpp)
 target_link_libraries(test_rfid_ranging_node picker_localisation_sensors_ranging_ros)

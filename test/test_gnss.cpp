@@ -589,6 +589,65 @@ TEST(PickerAssociation, NeighboursInAdjacentLanesDoNotSwapIdentities) {
   }
 }
 
+// Two people in one scan, 1.2 m apart, next to the sharp (sighted) prediction of picker 1; picker 2's unit is
+// unsighted (a 3.2 m prior) with its fix 3 m away. Alone, each person is picker 1 (its prediction is the
+// sharper one at both); together one of them must be somebody else (each picker is one person at most: the
+// joint association), and the one farther from picker 1's prediction is not picker 1.
+TEST(PickerAssociation, PeopleOfOneScanAreNeverTheSamePicker) {
+  PickerAssociationOptions o;
+  auto setUp = [](ThreeLanes& f) {
+    f.fixes(1.0, {{0.0, 0.0}, {0.0, 3.0}, {30.0, 3.0}});
+    // Picker 1 seen standing 0.2 m north of its fix: its bias is known, its prediction sharp.
+    ASSERT_TRUE(
+        f.ingest[0].addSighting(1.0, Eigen::Vector2d(0.0, 0.2), Eigen::Matrix2d::Identity() * 0.01).accepted);
+    f.fixes(2.0, {{0.0, 0.0}, {0.0, 3.0}, {30.0, 3.0}});
+  };
+  ThreeLanes alone;
+  setUp(alone);
+  const core::Observation near = alone.person(2.1, {0.0, 0.2});
+  const core::Observation farther = alone.person(2.1, {0.0, 1.4});
+  const AssociationResult near_alone = associatePerson(near, alone.pickers, {}, *alone.fx.map, o);
+  ThreeLanes alone2;
+  setUp(alone2);
+  const AssociationResult farther_alone = associatePerson(farther, alone2.pickers, {}, *alone2.fx.map, o);
+  EXPECT_EQ(near_alone.picker, 0);
+  EXPECT_EQ(farther_alone.picker, 0) << farther_alone.probabilities[0] << " "
+                                     << farther_alone.probabilities[1];
+
+  ThreeLanes together;
+  setUp(together);
+  const std::vector<AssociationResult> joint =
+      associatePeople({near, farther}, together.pickers, {}, *together.fx.map, o);
+  ASSERT_EQ(joint.size(), 2u);
+  EXPECT_NE(joint[1].picker, 0) << joint[1].probabilities[0];
+  EXPECT_LT(joint[1].probabilities[0], 0.5);
+  EXPECT_GT(joint[0].probabilities[0], joint[1].probabilities[0]);
+  for (const AssociationResult& a : joint) {  // marginals: a person is one picker or nobody
+    double sum = a.clutter_probability;
+    for (double p : a.probabilities) sum += p;
+    EXPECT_NEAR(sum, 1.0, 1e-9);
+  }
+  // Each picker is at most one person in expectation as well.
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_LE(joint[0].probabilities[i] + joint[1].probabilities[i], 1.0 + 1e-9);
+  if (joint[0].picker >= 0 && joint[1].picker >= 0) EXPECT_NE(joint[0].picker, joint[1].picker);
+  // One person seen by a robot's two lasers (0.1 m apart): one person, both sightings picker 1.
+  ThreeLanes twice;
+  setUp(twice);
+  const std::vector<AssociationResult> both =
+      associatePeople({near, twice.person(2.1, {0.1, 0.2})}, twice.pickers, {}, *twice.fx.map, o);
+  EXPECT_EQ(both[0].picker, 0);
+  EXPECT_EQ(both[1].picker, 0);
+  // One person alone: the single-detection form, the same as associatePerson.
+  ThreeLanes single;
+  setUp(single);
+  const std::vector<AssociationResult> one =
+      associatePeople({farther}, single.pickers, {}, *single.fx.map, o);
+  ASSERT_EQ(one.size(), 1u);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_NEAR(one[0].probabilities[i], farther_alone.probabilities[i], 1e-12);
+}
+
 namespace {
 // An identifying observation of `picker` listing the lattice nodes with |x|, |y| <= 2 at `inside` and, with
 // `outside` >= 0, every other node at `outside` (a negative observation lists them all).

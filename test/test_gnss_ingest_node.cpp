@@ -30,6 +30,18 @@ picker_localisation::topology::TopologicalMap shippedMap() {
 // Where picker_3 stands, and how far off its unit reads (3.6 m): the people test teaches gnss_ingest this offset,
 // and the PoseArray test relies on it.
 const Eigen::Vector2d kPicker3Truth(15.0, -2.0), kPicker3Offset(3.0, 2.0);
+// A LiDAR person of robot_1 at `at` (map frame), as leg_detector publishes it.
+picker_localisation::Observation personAt(const picker_localisation::topology::TopologicalMap& map,
+                                          const Eigen::Vector2d& at, const ros::Time& stamp) {
+  picker_localisation::core::Observation o;
+  o.stamp = stamp.toSec();
+  o.sensor = "lidar";
+  o.robot_id = "robot_1";
+  o.position = at;
+  o.position_covariance = Eigen::Matrix2d::Identity() * 0.09;
+  picker_localisation::core::setGaussianLikelihood(o, map, at, o.position_covariance);
+  return picker_localisation::ros_adapter::toMsg(o, map);
+}
 }  // namespace
 
 TEST(GnssIngestNode, BadFixesAreRejectedAndGoodOnesStillPublish) {
@@ -109,16 +121,7 @@ TEST(GnssIngestNode, PeopleNearAPickerIdentifyItAndRemoveItsGnssBias) {
     return fixes.getNumSubscribers() > 0 && people.getNumSubscribers() > 0 && bias_sub.getNumPublishers() > 0;
   }, 30.0));
   const Eigen::Vector2d truth = kPicker3Truth, offset = kPicker3Offset;
-  auto person = [&](const Eigen::Vector2d& at, const ros::Time& stamp) {
-    pl::core::Observation o;
-    o.stamp = stamp.toSec();
-    o.sensor = "lidar";
-    o.robot_id = "robot_1";
-    o.position = at;
-    o.position_covariance = Eigen::Matrix2d::Identity() * 0.09;
-    pl::core::setGaussianLikelihood(o, map, at, o.position_covariance);
-    return pl::ros_adapter::toMsg(o, map);
-  };
+  auto person = [&](const Eigen::Vector2d& at, const ros::Time& stamp) { return personAt(map, at, stamp); };
   auto lidar = [&](bool identifying) {
     std::size_t n = 0;
     for (const auto& o : c.obs) n += o.sensor == "lidar" && o.identifying == identifying;
@@ -281,6 +284,62 @@ TEST(GnssIngestNode, FollowsThePickerListOfTheTracker) {
                   info("picker_3", "/pickers/picker_3/fix")};
   registry.publish(list);
   ASSERT_TRUE(ranging_test::waitFor([&] { return fix1.getNumSubscribers() > 0; }));
+}
+
+// With stamp ordering (ordering_latency > 0; gnss_ingest_ordered.test runs this test alone), the people one
+// robot's laser saw at one stamp are associated together: each picker is at most one of them. picker_3's bias
+// is taught first (its prediction sharp), then two people 1.6 m apart next to it share a stamp. Alone, each
+// would be picker_3 (nobody else is near); together only the one where picker_3 stands is.
+TEST(GnssIngestNode, PeopleOfOneScanAreNeverTheSamePicker) {
+  namespace pl = picker_localisation;
+  ros::NodeHandle nh;
+  ranging_test::Collector c(nh, "GNSS ingestion");
+  const GeodeticDatum datum = shippedDatum();
+  const pl::topology::TopologicalMap map = shippedMap();
+  ros::Publisher fixes = nh.advertise<sensor_msgs::NavSatFix>("/pickers/picker_3/fix", 20);
+  ros::Publisher people = nh.advertise<pl::Observation>("/person_observations", 20);
+  ASSERT_TRUE(ranging_test::waitFor(
+      [&] {
+        return fixes.getNumSubscribers() > 0 && people.getNumSubscribers() > 0 &&
+               c.obs_sub.getNumPublishers() > 0;
+      },
+      30.0));
+  auto identified = [&](const std::string& id) {
+    std::size_t n = 0;
+    for (const auto& o : c.obs) n += o.sensor == "lidar" && o.identifying && o.picker_id == id;
+    return n;
+  };
+  const Eigen::Vector2d truth = kPicker3Truth, offset = kPicker3Offset;
+  const ros::Time t0 = ros::Time::now();
+  for (std::size_t k = 0; k < 4; ++k) {  // fix, then the person where picker_3 stands: its bias
+    const ros::Time t = t0 + ros::Duration(static_cast<double>(k));
+    fixes.publish(fixAt(datum, truth + offset, t));
+    ranging_test::spinFor(0.05);
+    people.publish(personAt(map, truth, t + ros::Duration(0.1)));
+    ASSERT_TRUE(ranging_test::waitFor([&] { return identified("picker_3") >= k + 1; }))
+        << "person " << k << " not identified";
+  }
+  // Two people at one stamp of one robot, 1.6 m apart, one where picker_3 stands. Alone, the other would be
+  // picker_3 as well (p ~ 0.99: nobody else is near; sensors::associatePerson, test_gnss); together only the
+  // one where picker_3 stands is.
+  const ros::Time t = t0 + ros::Duration(4.0);
+  fixes.publish(fixAt(datum, truth + offset, t));
+  ranging_test::spinFor(0.05);
+  const std::size_t lidar_before = c.obs.size();
+  people.publish(personAt(map, truth + Eigen::Vector2d(0.0, 1.6), t + ros::Duration(0.1)));
+  people.publish(personAt(map, truth, t + ros::Duration(0.1)));
+  ASSERT_TRUE(ranging_test::waitFor([&] { return identified("picker_3") >= 5; })) << "the pair";
+  ranging_test::spinFor(1.0);
+  EXPECT_EQ(identified("picker_3"), 5u);
+  bool found = false;
+  for (std::size_t k = lidar_before; k < c.obs.size(); ++k) {
+    const auto& o = c.obs[k];
+    if (o.sensor != "lidar" || !o.identifying) continue;
+    found = true;
+    EXPECT_NEAR(o.position.x, truth.x(), 1e-6);
+    EXPECT_NEAR(o.position.y, truth.y(), 1e-6);
+  }
+  EXPECT_TRUE(found);
 }
 
 int main(int argc, char** argv) {

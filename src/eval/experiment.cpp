@@ -485,10 +485,14 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
       publish(*neg);
   result_.lidar_detections += tracked.size();
   std::vector<Eigen::Vector2d> people;
-  for (const auto& t : tracked) {
-    // Identity for the anonymous people, as gnss_ingest gives it.
-    const sensors::AssociationResult a =
-        gnss_->associate(vision::LegPipeline::observation(t, *map_, s.stamp, s.robot_id));
+  // Identity for the anonymous people, as gnss_ingest gives it.
+  std::vector<core::Observation> scan_people;
+  for (const auto& t : tracked)
+    scan_people.push_back(vision::LegPipeline::observation(t, *map_, s.stamp, s.robot_id));
+  const std::vector<sensors::AssociationResult> scan_results = gnss_->associate(scan_people);  // jointly
+  for (std::size_t ti = 0; ti < tracked.size(); ++ti) {
+    const auto& t = tracked[ti];
+    const sensors::AssociationResult& a = scan_results[ti];
     if (a.picker >= 0 && dispatcher_) {  // the serving robot's own identified person: arrival when near
       const dispatch::Call* served = dispatcher_->servedBy(s.robot_id);
       const double d = (t.position - simulator_.robotPose(s.robot_index).position()).norm();

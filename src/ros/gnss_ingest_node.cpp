@@ -343,16 +343,32 @@ void GnssIngestNode::onBelief(const picker_localisation::PickerBelief& msg) {
 
 void GnssIngestNode::releaseOrdered() {
   if (checkClock()) return;
+  // People of one robot's sensor with one stamp come out next to each other (keys "person|<robot>|..."): they
+  // are associated together, each picker at most one of them (sensors::associatePeople).
+  std::vector<core::Observation> people;
+  auto flushPeople = [&]() {
+    if (!people.empty()) processPeople(people);
+    people.clear();
+  };
   for (auto& item : ordering_.release(ros::Time::now().toSec())) {
-    if (item.second.is_fix) {
-      const auto it = by_id_.find(item.second.picker);
-      if (it != by_id_.end()) processFix(*it->second, item.second.fix);
-    } else if (item.second.is_sighting) {
-      useIdentified(item.second.person);
+    Input& in = item.second;
+    if (!in.is_fix && !in.is_sighting) {
+      if (!people.empty() &&
+          (in.person.stamp != people.front().stamp || in.person.robot_id != people.front().robot_id ||
+           in.person.sensor != people.front().sensor))
+        flushPeople();
+      people.push_back(std::move(in.person));
+      continue;
+    }
+    flushPeople();
+    if (in.is_fix) {
+      const auto it = by_id_.find(in.picker);
+      if (it != by_id_.end()) processFix(*it->second, in.fix);
     } else {
-      processPerson(item.second.person);
+      useIdentified(in.person);
     }
   }
+  flushPeople();
 }
 
 bool GnssIngestNode::inMapFrame(const std::string& frame, const char* what) {
@@ -472,13 +488,18 @@ void GnssIngestNode::processFix(Picker& picker, const core::GnssFix& fix) {
 }
 
 void GnssIngestNode::processPerson(const core::Observation& person) {
-  const sensors::AssociationResult a = fleet_->associate(person);
-  if (a.picker >= 0 && !a.bias.accepted)
-    ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
-              a.bias.reason.c_str());
-  if (a.concerns_nobody) return;
-  pub_.publish(toMsg(a.observation, *map_, frame_id_));
-  ++published_;
+  processPeople({person});
+}
+
+void GnssIngestNode::processPeople(const std::vector<core::Observation>& people) {
+  for (const sensors::AssociationResult& a : fleet_->associate(people)) {
+    if (a.picker >= 0 && !a.bias.accepted)
+      ROS_DEBUG("gnss_ingest: %s: sighting not used for the bias: %s", a.observation.picker_id.c_str(),
+                a.bias.reason.c_str());
+    if (a.concerns_nobody) continue;
+    pub_.publish(toMsg(a.observation, *map_, frame_id_));
+    ++published_;
+  }
 }
 
 void GnssIngestNode::publishBias(Picker& picker, double stamp, const sensors::GnssResult& r) {

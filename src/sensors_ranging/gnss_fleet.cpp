@@ -42,17 +42,24 @@ std::vector<GnssIngest*> GnssFleet::ingests() {
 }
 
 AssociationResult GnssFleet::associate(const core::Observation& person) {
+  return associate(std::vector<core::Observation>{person}).front();
+}
+
+std::vector<AssociationResult> GnssFleet::associate(const std::vector<core::Observation>& people) {
+  if (people.empty()) return {};
   std::vector<const BeliefHistory*> histories;
   histories.reserve(pickers_.size());
   for (const auto& p : pickers_) histories.push_back(&p->beliefs);
-  ++counters_.people;
-  AssociationResult a =
-      associatePerson(person, ingests(), beliefViews(histories, person.stamp, options_.association), *map_,
-                      options_.association, &identity_);
-  if (a.picker >= 0) ++counters_.identified;
-  if (a.bias.accepted) ++counters_.sightings;
-  if (a.concerns_nobody) ++counters_.nobody;
-  return a;
+  std::vector<AssociationResult> results =
+      associatePeople(people, ingests(), beliefViews(histories, people.front().stamp, options_.association),
+                      *map_, options_.association, &identity_);
+  for (const AssociationResult& a : results) {
+    ++counters_.people;
+    if (a.picker >= 0) ++counters_.identified;
+    if (a.bias.accepted) ++counters_.sightings;
+    if (a.concerns_nobody) ++counters_.nobody;
+  }
+  return results;
 }
 
 bool GnssFleet::wantsIdentified(bool identifying, const std::string& sensor) const {

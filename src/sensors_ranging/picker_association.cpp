@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace picker_localisation {
 namespace sensors {
@@ -132,19 +133,22 @@ std::size_t IdentityEvidence::size() const {
   return n;
 }
 
-AssociationResult associatePerson(const core::Observation& person, const std::vector<GnssIngest*>& pickers,
-                                  const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
-                                  const PickerAssociationOptions& o, const IdentityEvidence* evidence) {
-  AssociationResult r;
-  r.observation = person;
-  r.probabilities.assign(pickers.size(), 0.0);
-  if (!o.enabled || person.identifying || !person.position || !person.position->allFinite() ||
-      !person.position_covariance.allFinite())
-    return r;
+namespace {
+
+bool associable(const core::Observation& person, const PickerAssociationOptions& o) {
+  return o.enabled && !person.identifying && person.position && person.position->allFinite() &&
+         person.position_covariance.allFinite();
+}
+
+// l_i(z) for every picker: the mixture of the bias-corrected fix and the belief, times the identity evidence.
+std::vector<double> personLikelihoods(const core::Observation& person,
+                                      const std::vector<GnssIngest*>& pickers,
+                                      const std::vector<BeliefView>& beliefs,
+                                      const topology::TopologicalMap& map, const PickerAssociationOptions& o,
+                                      const IdentityEvidence* evidence) {
   const Eigen::Vector2d z = *person.position;
   const Eigen::Matrix2d R = 0.5 * (person.position_covariance + person.position_covariance.transpose());
   std::vector<double> l(pickers.size(), 0.0);
-  double total = 0.0;
   for (std::size_t i = 0; i < pickers.size(); ++i) {
     const GnssIngest::Prediction fix = pickers[i]->predictPosition(person.stamp, o.speed, o.max_fix_age);
     const double g = fix.valid ? gaussian(z - fix.mean, fix.covariance + R) : 0.0;
@@ -157,15 +161,16 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
       l[i] = fix.valid ? g : b;
     if (evidence && fix.valid)
       l[i] *= evidence->ratio(pickers[i]->pickerId(), person.stamp, z, fix.mean, fix.covariance + R, map, o);
-    total += l[i];
   }
-  const double norm = o.clutter_density + total;
-  r.clutter_probability = o.clutter_density / norm;
+  return l;
+}
+
+// Identity (or candidates) from the probabilities already in r; an identified person is a bias sighting.
+void decide(AssociationResult& r, const std::vector<GnssIngest*>& pickers,
+            const PickerAssociationOptions& o) {
   std::size_t best = 0;
-  for (std::size_t i = 0; i < pickers.size(); ++i) {
-    r.probabilities[i] = l[i] / norm;
+  for (std::size_t i = 0; i < pickers.size(); ++i)
     if (r.probabilities[i] > r.probabilities[best]) best = i;
-  }
   if (pickers.empty() || r.probabilities[best] < o.min_probability) {
     if (o.min_candidate_probability > 0.0 && !pickers.empty()) {
       for (std::size_t i = 0; i < pickers.size(); ++i)
@@ -173,13 +178,122 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
           r.observation.candidate_pickers.push_back(pickers[i]->pickerId());
       r.concerns_nobody = r.observation.candidate_pickers.empty();
     }
-    return r;
+    return;
   }
   r.picker = static_cast<int>(best);
   r.observation.identifying = true;
   r.observation.picker_id = pickers[best]->pickerId();
-  r.bias = pickers[best]->addSighting(person.stamp, z, R);
-  return r;
+  r.bias = pickers[best]->addSighting(
+      r.observation.stamp, *r.observation.position,
+      0.5 * (r.observation.position_covariance + r.observation.position_covariance.transpose()));
+}
+
+// Marginals of the joint association (associatePeople's comment) of people whose l rows are `l`.
+constexpr double kCandidateFloor = 1e-4;
+constexpr std::size_t kMaxEvents = 200000;
+
+void jointMarginals(const std::vector<std::vector<double>>& l, double c,
+                    std::vector<std::vector<double>>& p) {
+  const std::size_t k = l.size();
+  const std::size_t n = k ? l[0].size() : 0;
+  p.assign(k, std::vector<double>(n, 0.0));
+  std::vector<std::vector<std::size_t>> candidates(k);
+  double events = 1.0;
+  for (std::size_t j = 0; j < k; ++j) {
+    double norm = c;
+    for (double v : l[j]) norm += v;
+    for (std::size_t i = 0; i < n; ++i)
+      if (l[j][i] >= kCandidateFloor * norm) candidates[j].push_back(i);
+    events *= static_cast<double>(candidates[j].size() + 1);
+  }
+  if (k == 1 || events > static_cast<double>(kMaxEvents)) {  // single-detection form
+    for (std::size_t j = 0; j < k; ++j) {
+      double norm = c;
+      for (double v : l[j]) norm += v;
+      for (std::size_t i = 0; i < n; ++i) p[j][i] = l[j][i] / norm;
+    }
+    return;
+  }
+  std::vector<int> chosen(k, -1);
+  std::vector<char> used(n, 0);
+  double total = 0.0;
+  std::function<void(std::size_t, double)> walk = [&](std::size_t j, double w) {
+    if (j == k) {
+      total += w;
+      for (std::size_t d = 0; d < k; ++d)
+        if (chosen[d] >= 0) p[d][static_cast<std::size_t>(chosen[d])] += w;
+      return;
+    }
+    chosen[j] = -1;
+    walk(j + 1, w * c);
+    for (std::size_t i : candidates[j]) {
+      if (used[i]) continue;
+      used[i] = 1;
+      chosen[j] = static_cast<int>(i);
+      walk(j + 1, w * l[j][i]);
+      used[i] = 0;
+    }
+    chosen[j] = -1;
+  };
+  walk(0, 1.0);
+  if (!(total > 0.0)) return;
+  for (auto& row : p)
+    for (double& v : row) v /= total;
+}
+
+}  // namespace
+
+AssociationResult associatePerson(const core::Observation& person, const std::vector<GnssIngest*>& pickers,
+                                  const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
+                                  const PickerAssociationOptions& o, const IdentityEvidence* evidence) {
+  return associatePeople({person}, pickers, beliefs, map, o, evidence).front();
+}
+
+std::vector<AssociationResult> associatePeople(const std::vector<core::Observation>& people,
+                                               const std::vector<GnssIngest*>& pickers,
+                                               const std::vector<BeliefView>& beliefs,
+                                               const topology::TopologicalMap& map,
+                                               const PickerAssociationOptions& o,
+                                               const IdentityEvidence* evidence) {
+  std::vector<AssociationResult> results(people.size());
+  std::vector<std::size_t> index;  // the associable people
+  std::vector<std::vector<double>> l;
+  for (std::size_t j = 0; j < people.size(); ++j) {
+    AssociationResult& r = results[j];
+    r.observation = people[j];
+    r.probabilities.assign(pickers.size(), 0.0);
+    if (!associable(people[j], o)) continue;
+    index.push_back(j);
+    l.push_back(personLikelihoods(people[j], pickers, beliefs, map, o, evidence));
+  }
+  // Layers of people no two of which are within kSamePersonDistance (one person seen by two lasers lands in
+  // two layers); each layer is associated jointly.
+  std::vector<std::vector<std::size_t>> layers;  // positions in `index`
+  for (std::size_t q = 0; q < index.size(); ++q) {
+    const Eigen::Vector2d& z = *people[index[q]].position;
+    auto apart = [&](const std::vector<std::size_t>& layer) {
+      for (std::size_t other : layer)
+        if ((*people[index[other]].position - z).norm() < kSamePersonDistance) return false;
+      return true;
+    };
+    auto layer = std::find_if(layers.begin(), layers.end(), apart);
+    if (layer == layers.end()) layer = layers.insert(layers.end(), std::vector<std::size_t>{});
+    layer->push_back(q);
+  }
+  for (const std::vector<std::size_t>& layer : layers) {
+    std::vector<std::vector<double>> layer_l, p;
+    for (std::size_t q : layer) layer_l.push_back(l[q]);
+    jointMarginals(layer_l, o.clutter_density, p);
+    for (std::size_t m = 0; m < layer.size(); ++m) {
+      AssociationResult& r = results[index[layer[m]]];
+      r.probabilities = p[m];
+      double assigned = 0.0;
+      for (double v : p[m]) assigned += v;
+      r.clutter_probability = std::max(0.0, 1.0 - assigned);
+    }
+  }
+  for (std::size_t j : index) decide(results[j], pickers, o);  // bias sightings after every decision
+  return results;
 }
 
 bool addIdentifyingSighting(const core::Observation& obs, const std::vector<GnssIngest*>& pickers) {

@@ -72,6 +72,7 @@ class GnssIngestNode {
   void releaseOrdered();
   void processFix(Picker& picker, const core::GnssFix& fix);
   void processPerson(const core::Observation& person);
+  void processPeople(const std::vector<core::Observation>& people);  // one robot sensor's, one stamp: jointly
   void publishBias(Picker& picker, double stamp, const sensors::GnssResult& r);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 

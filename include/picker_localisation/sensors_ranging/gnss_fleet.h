@@ -49,6 +49,8 @@ class GnssFleet {
   // bias-corrected fix, its belief association_belief_lag before the detection and the identity evidence
   // (associatePerson); an identified person is a bias sighting of that picker.
   AssociationResult associate(const core::Observation& person);
+  // The people of one scan of one sensor, jointly (associatePeople): each picker is at most one of them.
+  std::vector<AssociationResult> associate(const std::vector<core::Observation>& people);
   // Whether an observation of the fleet's observation stream is of use here: identifying, from a sensor in
   // association_identity_sensors or bias_sighting_sensors (the node's filter before decoding a message).
   bool wantsIdentified(bool identifying, const std::string& sensor) const;

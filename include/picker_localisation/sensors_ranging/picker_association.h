@@ -9,7 +9,8 @@
 // alone when the other is missing). A mixture, not a product: the belief was built from the same fixes, and a
 // confidently wrong belief must not veto the fix (that is the lane we want to correct). Against the
 // hypothesis "nobody we track" (clutter density c: false legs, other workers) the association probabilities
-// are p_i = l_i / (c + sum_j l_j) (one detection, one picker at most: the standard single-scan PDA form).
+// are p_i = l_i / (c + sum_j l_j) for one detection (the single-scan PDA form); the people of one scan are
+// associated jointly, each picker at most one of them (associatePeople).
 // p_i >= min_probability makes the detection an identifying observation of picker i and a metric sighting for
 // its bias estimate; anything less stays anonymous, for the trackers of the pickers whose p_i reaches
 // association_min_candidate_probability (Observation::candidate_pickers; none: not published at all). Before
@@ -126,6 +127,22 @@ AssociationResult associatePerson(const core::Observation& person, const std::ve
                                   const std::vector<BeliefView>& beliefs, const topology::TopologicalMap& map,
                                   const PickerAssociationOptions& options,
                                   const IdentityEvidence* evidence = nullptr);
+
+// The people one sensor saw at one instant, associated jointly (Bar-Shalom's joint probabilistic data
+// association): a joint event names each person one picker or clutter and each picker at most one person, its
+// weight the product of their l_i (c for clutter); p_ji sums the weights of the events with person j ->
+// picker i. One person: exactly associatePerson's l_i / (c + sum l). People within kSamePersonDistance of
+// each other are taken as one person seen twice (a robot's two lasers) and are not made exclusive. Events are
+// enumerated over the pickers a person could be (single-person probability >= 1e-4); a group of more than
+// 200,000 events keeps the single-person probabilities. Bias sightings follow all the decisions. Results in
+// the order of `people`.
+constexpr double kSamePersonDistance = 0.5;  // m
+std::vector<AssociationResult> associatePeople(const std::vector<core::Observation>& people,
+                                               const std::vector<GnssIngest*>& pickers,
+                                               const std::vector<BeliefView>& beliefs,
+                                               const topology::TopologicalMap& map,
+                                               const PickerAssociationOptions& options,
+                                               const IdentityEvidence* evidence = nullptr);
 
 // An identifying observation of a sensor in bias_sighting_sensors (RFID, UWB) with a metric position is a
 // sighting of its picker: GnssIngest::addSighting with the observation's position and covariance. Returns
