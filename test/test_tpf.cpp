@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <set>
@@ -169,6 +170,8 @@ TEST(TpfParamsTest, ConfigFileHoldsTableI) {
   EXPECT_EQ(p.velocity_follows_edge, d.velocity_follows_edge);
   EXPECT_EQ(p.velocity_weight_product, d.velocity_weight_product);
   EXPECT_EQ(p.reverse_rate, d.reverse_rate);
+  EXPECT_EQ(p.stand_rate, d.stand_rate);
+  EXPECT_EQ(p.walk_rate, d.walk_rate);
   EXPECT_EQ(p.lane_change_model, d.lane_change_model);
   EXPECT_EQ(p.lane_change_leak, d.lane_change_leak);
   EXPECT_EQ(p.lane_change_max_hops, d.lane_change_max_hops);
@@ -212,6 +215,8 @@ TEST(TpfParamsTest, PresetsAndErrors) {
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{prediction_rate: 10.5}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{lane_change_max_hops: 51}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{jsd_threshold: 2.0}")), std::runtime_error);
+  EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{walk_rate: 0}")), std::runtime_error);
+  EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{stand_rate: -0.1}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{resampling: stratified}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYaml(YAML::Load("{method: nope}")), std::runtime_error);
   EXPECT_THROW(TpfParams::fromYamlFile("/nonexistent/tpf.yaml"), std::runtime_error);
@@ -834,6 +839,112 @@ TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {
   };
   EXPECT_GT(laneShare(true), 0.9);
   EXPECT_LT(laneShare(false), 0.5);
+}
+
+TEST(TpfStanding, TheChainOfStopsAndStartsAndAStandingParticleStays) {
+  // stand_rate s, walk_rate w, every particle walking at first, steps of 1 s: a step stops a walking particle
+  // with p_s = 1 - exp(-s) and starts a standing one with p_w = 1 - exp(-w), so after k steps the standing
+  // share is p_s / (p_s + p_w) (1 - (1 - p_s - p_w)^k). A standing particle does not jump.
+  auto map = laneMap(40, 3.0);
+  TpfParams p = staticParams(20000);
+  p.velocity_follows_edge = true;
+  p.velocity_init_mean = 0.5;
+  p.stand_rate = 0.05;
+  p.walk_rate = 0.15;
+  TopologicalParticleFilter f(map, p, 11);
+  ASSERT_TRUE(f.update(obsAt(0.0, {2}, {1.0})).ok());
+  for (int k = 1; k <= 10; ++k) ASSERT_TRUE(f.predictTo(k));
+  std::size_t standing = 0;
+  for (const auto& q : f.particles()) standing += q.standing ? 1 : 0;
+  const double p_s = 1.0 - std::exp(-0.05), p_w = 1.0 - std::exp(-0.15);
+  EXPECT_NEAR(static_cast<double>(standing) / f.particles().size(),
+              p_s / (p_s + p_w) * (1.0 - std::pow(1.0 - p_s - p_w, 10)), 0.01);
+
+  TpfParams still = staticParams(2000);
+  still.velocity_init_mean = 0.5;
+  still.stand_rate = 20.0;  // nearly every particle stops in the first step, before it can jump
+  still.walk_rate = 1e-9;
+  TopologicalParticleFilter g(map, still, 12);
+  ASSERT_TRUE(g.update(obsAt(0.0, {2}, {1.0})).ok());
+  ASSERT_TRUE(g.predictTo(0.5));
+  ASSERT_TRUE(g.predictTo(60.0));  // walking at 0.5 m/s a particle would be ~10 nodes on
+  std::size_t stayed = 0;
+  for (const auto& q : g.particles()) {
+    if (q.standing) EXPECT_EQ(q.node, 2u);
+    stayed += q.standing && q.node == 2 ? 1 : 0;
+  }
+  EXPECT_GT(stayed, g.particles().size() * 99 / 100);
+  EXPECT_EQ(TpfParams::presetForMethod("paper_tpf").stand_rate, 0.0);  // the paper's particles always walk
+}
+
+TEST(TpfStanding, AParticleThatStopsInTheLaneItChangedIntoHasArrived) {
+  // Particles leave lane 5 at its far end and follow the headland path into lane 4 or 6 (it ends one node
+  // inside the lane). One that stops in the new lane before the path's end has arrived there: no path left,
+  // its side remembered. Left on the path it stayed out of the lane swaps and the shared lane masses while it
+  // stood.
+  auto map = polytunnel();
+  TpfParams p = staticParams(4000);
+  p.velocity_follows_edge = true;
+  p.lane_change_model = true;
+  p.velocity_init_mean = 0.0;
+  p.velocity_init_variance = 0.25;  // every direction; about a quarter walk on towards the headland
+  p.stand_rate = 0.1;
+  p.walk_rate = 1e-9;
+  TopologicalParticleFilter f(map, p, 21);
+  const NodeIndex end = *map->index("r5_9");
+  ASSERT_TRUE(f.update(obsAt(0.0, {end}, {1.0})).ok());
+  std::size_t arrived = 0;
+  for (int k = 1; k <= 40; ++k) {
+    ASSERT_TRUE(f.predictTo(0.5 * k));
+    for (const auto& q : f.particles())
+      if (q.standing && map->lane(q.node) != topology::kNoLane && map->lane(q.node) != map->lane(end)) {
+        EXPECT_EQ(q.lane_change, 0u) << map->node(q.node).name;
+        arrived += q.last_lane_change != 0 ? 1 : 0;  // came by a lane-change path (the leak takes others)
+      }
+  }
+  EXPECT_GT(arrived, 0u);
+}
+
+TEST(TpfStanding, APickerStandingNearALaneEndIsNamedInTheLane) {
+  // A picker walks lane 5 (phone fixes, 3.2 m prior, a slowly wandering 1-2 m error) and stands 300 s at
+  // r5_8, 6 m from the headland. Every particle walking, the cloud that best explains a standing picker near
+  // a lane end bounces about the headland, where a particle can step either way, while in the lane it walks
+  // on past the fixes: the headland was named for minutes. Particles that stand stay in the lane.
+  auto map = polytunnel();
+  const NodeIndex start = *map->index("r5_0"), stand = *map->index("r5_8");
+  const Eigen::Vector2d a = map->position2d(start), b = map->position2d(stand);
+  const double walk_s = (b - a).norm() / 0.5;
+  auto inLane = [&](double stand_rate, std::uint64_t seed) {
+    TpfParams p;  // the product's defaults
+    p.num_particles = 1000;
+    p.stand_rate = stand_rate;
+    TopologicalParticleFilter f(map, p, seed);
+    EXPECT_TRUE(f.update(obsAt(0.0, {start}, {1.0}, true, "uwb")).ok());
+    int named = 0, samples = 0;
+    for (int k = 1; k <= static_cast<int>(walk_s) + 300; ++k) {
+      const double t = k;
+      const bool walking = t < walk_s;
+      const Eigen::Vector2d truth = walking ? Eigen::Vector2d(a + (b - a) * (t / walk_s)) : b;
+      const Eigen::Vector2d error(0.8 * std::sin(t / 70.0), 1.5 * std::cos(t / 50.0));
+      core::Observation o = biasedFix(*map, t, truth + error, 9.0, {0.0, 0.0}, 10.25, 2.0 * 6.25 / 300.0);
+      o.velocity = walking ? Eigen::Vector2d((b - a).normalized() * 0.5) : Eigen::Vector2d(0.0, 0.0);
+      EXPECT_TRUE(f.update(o).ok());
+      if (t >= walk_s + 60.0) {
+        ++samples;
+        named += map->lane(f.belief().map_node) == map->lane(stand) ? 1 : 0;
+      }
+    }
+    return static_cast<double>(named) / samples;
+  };
+  double walking_only = 0.0, with_standing = 0.0;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    walking_only += inLane(0.0, seed) / 4.0;
+    with_standing += inLane(TpfParams().stand_rate, seed) / 4.0;
+  }
+  EXPECT_GT(with_standing, 0.9) << "walking only: " << walking_only;
+  EXPECT_LT(walking_only, with_standing - 0.2) << "with standing: " << with_standing;
+  std::cout << "lane named while standing: walking only " << walking_only << ", with standing "
+            << with_standing << std::endl;
 }
 
 // A map edited at run time: the particles move onto the new map (removed node: the nearest), velocities and

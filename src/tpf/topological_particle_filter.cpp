@@ -422,7 +422,8 @@ double TopologicalParticleFilter::particleWeight(const Particle& p, double norma
   if (obs.velocity && gamma.velocity > 0.0 && params_.motion_model == MotionModel::kVelocity) {
     const double vs = obs.velocity->norm();
     const double sigma = std::max(0.5 * vs, params_.min_velocity_sigma);
-    const double speed = std::sqrt(static_cast<double>(p.vx) * p.vx + static_cast<double>(p.vy) * p.vy);
+    const double speed =
+        p.standing ? 0.0 : std::sqrt(static_cast<double>(p.vx) * p.vx + static_cast<double>(p.vy) * p.vy);
     const double z = (speed - vs) / sigma;
     const double g = std::exp(-0.5 * z * z);  // Gaussian of Eq. 8, peak 1
     // cos of the angle between the particle and the observed velocity; 0 (no preference) if either is zero.
@@ -579,6 +580,7 @@ void TopologicalParticleFilter::redraw(const core::Observation& obs, std::size_t
     p.dwell = static_cast<float>(params_.dwell_init_min + span * uniform01(rng_));
     p.lane_change = 0;
     p.last_lane_change = 0;
+    p.standing = false;
     p.bias_variance = -1.0f;  // the bias starts from the next GNSS fix's prior
   }
   unconnected_p_ = params_.unconnected_jump_probability;
@@ -593,9 +595,15 @@ void TopologicalParticleFilter::predict(double dt) {
     return;
   }
   reverseSomeVelocities(dt);
+  switchStanding(dt);
   std::vector<double>& count = node_scratch_b_;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    moveWithVelocityModel(i, dt);
+    if (particles_[i].standing) {
+      spare_bits_[i] = static_cast<std::uint32_t>(rng_() >> 32);  // addNoise's draw, as for a walking one
+      particles_[i].dwell = 0.0f;  // it walks on from a standstill: Eqs. 2-3's dwell restarts
+    } else {
+      moveWithVelocityModel(i, dt);
+    }
     const NodeIndex n = particles_[i].node;
     if (count[n] == 0.0) touched_.push_back(n);
     count[n] += 1.0;
@@ -643,6 +651,30 @@ void TopologicalParticleFilter::reverseSomeVelocities(double dt) {
   for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
     particles_[i].vx = -particles_[i].vx;
     particles_[i].vy = -particles_[i].vy;
+  }
+}
+
+void TopologicalParticleFilter::switchStanding(double dt) {
+  // Not in the paper (TpfParams::stand_rate): a two-state Markov chain per particle, walking -> standing at
+  // stand_rate, standing -> walking at walk_rate. Candidates are drawn with geometric gaps at the larger of
+  // the two step probabilities and switch with the ratio of their own state's to it (one draw per candidate).
+  if (!(params_.stand_rate > 0.0 && dt > 0.0)) return;
+  const double p_stand = 1.0 - std::exp(-params_.stand_rate * dt);
+  const double p_walk = 1.0 - std::exp(-params_.walk_rate * dt);
+  const double p_max = std::min(1.0, std::max(p_stand, p_walk));
+  if (!(p_max > 0.0)) return;
+  std::geometric_distribution<std::size_t> gap(p_max);
+  for (std::size_t i = gap(rng_); i < particles_.size(); i += 1 + gap(rng_)) {
+    Particle& p = particles_[i];
+    if (!(uniform01(rng_) * p_max < (p.standing ? p_walk : p_stand))) continue;
+    p.standing = !p.standing;
+    // A particle that stops inside a lane on its way in from a lane change has arrived: it is in that lane
+    // (the side is remembered as after the path's end). Left on the path, it stayed out of the lane swaps and
+    // the lane masses' sharing for as long as it stood, and a standing cloud one lane off held its lane.
+    if (p.standing && p.lane_change != 0 && map_->lane(p.node) != topology::kNoLane) {
+      p.last_lane_change = p.lane_change;
+      p.lane_change = 0;
+    }
   }
 }
 
@@ -882,7 +914,7 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     const bool product = params_.velocity_weight_product;
     for (std::size_t i = 0; i < particles_.size(); ++i) {
       const Particle& p = particles_[i];
-      const float speed = std::sqrt(p.vx * p.vx + p.vy * p.vy);
+      const float speed = p.standing ? 0.0f : std::sqrt(p.vx * p.vx + p.vy * p.vy);
       const float z = (speed - vs) * inv_sigma;
       const float denom = speed * vs;
       const float cosang = denom > 1e-12f ? (p.vx * ox + p.vy * oy) / denom : 0.0f;

@@ -72,6 +72,10 @@ std::string TpfParams::validate() const {
     return core::badValue("lane_change_keep_side", lane_change_keep_side, "in [0, 1]");
   if (!(reverse_rate >= 0.0) || !std::isfinite(reverse_rate))
     return core::badValue("reverse_rate", reverse_rate, "finite and >= 0");
+  if (!(stand_rate >= 0.0) || !std::isfinite(stand_rate))
+    return core::badValue("stand_rate", stand_rate, "finite and >= 0");
+  if (!(walk_rate > 0.0) || !std::isfinite(walk_rate))
+    return core::badValue("walk_rate", walk_rate, "finite and > 0");
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
     return core::badValue("turn_projection_fraction", turn_projection_fraction, "in [0, 1]");
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell))
@@ -169,6 +173,8 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "velocity_weight_product",
                                                 "velocity_follows_edge",
                                                 "reverse_rate",
+                                                "stand_rate",
+                                                "walk_rate",
                                                 "lane_change_model",
                                                 "lane_change_leak",
                                                 "lane_change_max_hops",
@@ -242,6 +248,8 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "velocity_weight_product", p.velocity_weight_product);
   read(node, "velocity_follows_edge", p.velocity_follows_edge);
   read(node, "reverse_rate", p.reverse_rate);
+  read(node, "stand_rate", p.stand_rate);
+  read(node, "walk_rate", p.walk_rate);
   read(node, "lane_change_model", p.lane_change_model);
   read(node, "lane_change_leak", p.lane_change_leak);
   read(node, "lane_change_max_hops", p.lane_change_max_hops);
@@ -298,6 +306,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.velocity_follows_edge = false;
     p.velocity_weight_product = false;
     p.reverse_rate = 0.0;
+    p.stand_rate = 0.0;
     p.lane_change_model = false;
     p.jsd_monitor = true;
     p.reinit_fraction = 1.0;

@@ -84,6 +84,7 @@ struct Particle {
   // dt over the recent fixes, each forgotten with the memory's time constant.
   float bias_integral_x = 0.0f, bias_integral_y = 0.0f;  // m s
   float bias_time = 0.0f;                                // s
+  bool standing = false;  // TpfParams::stand_rate: the particle does not move; its speed is 0 to Eq. 8
 };
 
 enum class UpdateStatus {
@@ -203,6 +204,7 @@ class TopologicalParticleFilter {
   void predict(double dt);
   void predictFixedLambda(double dt);                    // Khan et al. 2020's fixed-rate motion
   void reverseSomeVelocities(double dt);                 // mid-lane turns (reverse_rate)
+  void switchStanding(double dt);                        // stops and starts (stand_rate, walk_rate)
   void moveWithVelocityModel(std::size_t i, double dt);  // Eqs. 2-7 for particle i
   topology::NodeIndex projectOnEdges(Particle& p);
   void jumpAlong(Particle& p, std::uint32_t arc, double pr, double tau, topology::NodeIndex path_next);

@@ -75,6 +75,15 @@ struct TpfParams {
   // 1/s, rate at which a particle turns round (velocity negated) between nodes, for pickers who walk back
   // along the lane (Table I p_reverse); 0: only lane ends and corners turn a particle (paper).
   double reverse_rate = 0.01;
+  // Standing (not in the paper): pickers stop for minutes (picking a bush, packing trays, waiting for the
+  // robot they called). A walking particle stops at stand_rate (1/s) and a standing one walks on at walk_rate
+  // (1/s); a standing particle does not jump and its speed is 0 to the velocity term of Eq. 8. Without it
+  // every particle keeps walking at its smoothed speed, and the cloud that best explains a picker standing
+  // near a lane end bounced about the headland (docs/readme/tpf.md). 1/(1 + 10) of the particles stand while
+  // nothing says the picker stands; a stop lasts 20 s unless the fixes keep it. stand_rate 0: always walk
+  // (paper).
+  double stand_rate = 0.005;
+  double walk_rate = 0.05;
   // Lane-change structure of the farm (not in the paper; Polvara et al. 2021, Sec. VI: pickers walk on into the
   // adjacent lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
   // non-lane nodes to the nearest end of the adjacent lane on each side (at most lane_change_max_hops hops).
