@@ -192,6 +192,43 @@ TEST(ClusterTracker, StableIdsHysteresisAndGating) {
   EXPECT_TRUE(tracker.tracks().empty());
 }
 
+TEST(ClusterTracker, WindowVelocityIsTheWalkNotTheLegSwing) {
+  // A person walks +x at 0.5 m/s, seen at 10 Hz; the leg pair's centroid swings +-0.15 m across and along the
+  // walk from scan to scan. The scan-to-scan velocity is mostly the swing (3 m/s); the track's displacement
+  // over velocity_window (2 s) is the walk. None before the track spans half the window; a stamp going back
+  // starts the window again.
+  using picker_localisation::vision::ClusterTracker;
+  using picker_localisation::vision::ClusterTrackerOptions;
+  ClusterTrackerOptions o;
+  o.velocity_window = 2.0;
+  ClusterTracker tracker(o);
+  double worst_scan_to_scan = 0.0;
+  for (int k = 0; k <= 60; ++k) {
+    const double t = 0.1 * k, swing = (k % 2 ? 0.15 : -0.15);
+    const auto& tracks = tracker.update(t, {Eigen::Vector2d(0.5 * t + swing, swing)});
+    ASSERT_EQ(tracks.size(), 1u);
+    const auto& tr = tracks.front();
+    if (t < 0.95) {
+      EXPECT_FALSE(tr.has_window_velocity) << t;
+    } else if (t > 1.05) {
+      ASSERT_TRUE(tr.has_window_velocity) << t;
+      EXPECT_NEAR(tr.window_velocity.x(), 0.5, 0.35 / (std::min(t, 2.0))) << t;  // the swing over the span
+      EXPECT_NEAR(tr.window_velocity.y(), 0.0, 0.35 / (std::min(t, 2.0))) << t;
+      worst_scan_to_scan = std::max(worst_scan_to_scan, std::abs(tr.velocity.y()));
+    }
+    if (t >= 2.0) EXPECT_LE(tr.recent.size(), 22u);  // the window, not the track's life
+  }
+  EXPECT_GT(worst_scan_to_scan, 1.0);                                    // what the window is for
+  const auto& back = tracker.update(5.0, {Eigen::Vector2d(2.9, -0.1)});  // last at 6.0 s
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_FALSE(back.front().has_window_velocity);
+  ClusterTrackerOptions none;
+  none.velocity_window = 0.0;
+  ClusterTracker off(none);
+  for (int k = 0; k <= 30; ++k)
+    EXPECT_FALSE(off.update(0.1 * k, {Eigen::Vector2d(0.05 * k, 0.0)}).front().has_window_velocity);
+}
+
 TEST(LidarCameraFusion, NearestClusterInConeIsPromoted) {
   LidarCameraFusionOptions o;
   o.cone_margin = 0.0;
@@ -276,6 +313,7 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
   EXPECT_DOUBLE_EQ(o.detector.leg_threshold, 0.3);
   EXPECT_EQ(o.tracker.tentative_misses, 2);
   EXPECT_DOUBLE_EQ(o.position_sigma, 0.2);
+  EXPECT_DOUBLE_EQ(o.tracker.velocity_window, 2.0);  // default
   EXPECT_TRUE(o.camera_fusion);  // a detections topic enables fusion, as in the node
   ASSERT_EQ(unknown.size(), 1u);  // scan_topics is a node key: known
   EXPECT_NE(unknown[0].find("'leg_treshold'"), std::string::npos) << unknown[0];
@@ -283,7 +321,7 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
   for (const char* bad :
        {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}", "{hits_to_confirm: 0}",
         "{leg_threshold: abc}", "{negative_p_detect: 1.0}", "{negative_range_max: 2.0}",
-        "{negative_period: -1}", "{negative_clearance: -0.5}"}) {
+        "{negative_period: -1}", "{negative_clearance: -0.5}", "{velocity_window: -1}"}) {
     try {
       LegPipelineOptions::fromYaml(YAML::Load(bad));
       ADD_FAILURE() << bad << " accepted";

@@ -601,6 +601,7 @@ void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper&
   stat.add("exceptions caught (belief reset)", core.exceptions);
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);
+  stat.add("unidentified people taken for someone else", c.someone_else);
   stat.add("predictions", c.predictions);
   stat.add("what-if calls", t.what_if_calls);
   stat.add("resets", core.resets);

@@ -1,6 +1,7 @@
 #include "picker_localisation/sensors_vision/cluster_tracker.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "picker_localisation/sensors_vision/munkres.h"
 
@@ -12,6 +13,19 @@ ClusterTracker::ClusterTracker(ClusterTrackerOptions options) : options_(options
 void ClusterTracker::reset() {
   tracks_.clear();
   has_stamp_ = false;
+}
+
+void ClusterTracker::remember(ClusterTrack& t, double stamp) const {
+  const double window = options_.velocity_window;
+  if (!(window > 0.0) || !std::isfinite(stamp)) return;
+  if (!t.recent.empty() && !(stamp > t.recent.back().first)) t.recent.clear();  // a stamp back: start again
+  t.recent.emplace_back(stamp, t.position);
+  // Keep the newest update at least `window` old, so the span covers the window once the track is that old.
+  while (t.recent.size() > 2 && stamp - t.recent[1].first >= window) t.recent.pop_front();
+  const double span = stamp - t.recent.front().first;
+  t.has_window_velocity = span >= 0.5 * window;
+  t.window_velocity = t.has_window_velocity ? Eigen::Vector2d((t.position - t.recent.front().second) / span)
+                                            : Eigen::Vector2d::Zero();
 }
 
 const std::vector<ClusterTrack>& ClusterTracker::update(double stamp, const std::vector<Eigen::Vector2d>& detections) {
@@ -41,6 +55,7 @@ const std::vector<ClusterTrack>& ClusterTracker::update(double stamp, const std:
                                                    (1.0 - options_.velocity_smoothing) * t.velocity);
       }
       t.position = detections[j];
+      remember(t, stamp);
       t.updated = true;
       t.detection = j;
       ++t.hits;
@@ -72,6 +87,7 @@ const std::vector<ClusterTrack>& ClusterTracker::update(double stamp, const std:
     t.detection = j;
     t.last_update = stamp;
     t.confirmed = options_.hits_to_confirm <= 1;
+    remember(t, stamp);
     tracks_.push_back(t);
   }
   if (!has_stamp_ || stamp >= last_stamp_) {

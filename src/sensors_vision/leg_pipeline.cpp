@@ -12,14 +12,32 @@ namespace picker_localisation {
 namespace vision {
 
 const std::vector<std::string>& LegPipelineOptions::yamlKeys() {
-  static const std::vector<std::string> keys = {
-      "leg_threshold",    "max_leg_range",      "max_pair_distance", "single_leg_people",
-      "jump_distance",    "min_cluster_points", "gate_distance",     "hits_to_confirm",
-      "misses_to_delete", "tentative_misses",   "promote_after",     "demote_after",
-      "camera_weight",    "position_sigma",     "require_confirmed", "max_fusion_cluster_width",
-      "cone_half_width",  "camera_fusion",      "threshold_reference_increment",
-      "negative_information", "negative_period", "negative_p_detect", "negative_range_full",
-      "negative_range_max",   "negative_clearance"};
+  static const std::vector<std::string> keys = {"leg_threshold",
+                                                "max_leg_range",
+                                                "max_pair_distance",
+                                                "single_leg_people",
+                                                "jump_distance",
+                                                "min_cluster_points",
+                                                "gate_distance",
+                                                "hits_to_confirm",
+                                                "misses_to_delete",
+                                                "tentative_misses",
+                                                "promote_after",
+                                                "demote_after",
+                                                "camera_weight",
+                                                "position_sigma",
+                                                "require_confirmed",
+                                                "max_fusion_cluster_width",
+                                                "cone_half_width",
+                                                "camera_fusion",
+                                                "threshold_reference_increment",
+                                                "negative_information",
+                                                "negative_period",
+                                                "negative_p_detect",
+                                                "negative_range_full",
+                                                "negative_range_max",
+                                                "negative_clearance",
+                                                "velocity_window"};
   return keys;
 }
 
@@ -56,6 +74,7 @@ LegPipelineOptions LegPipelineOptions::fromYaml(const YAML::Node& y, std::vector
   read(y, "hits_to_confirm", o.tracker.hits_to_confirm);
   read(y, "misses_to_delete", o.tracker.misses_to_delete);
   read(y, "tentative_misses", o.tracker.tentative_misses);
+  read(y, "velocity_window", o.tracker.velocity_window);
   read(y, "promote_after", o.fusion.promote_after);
   read(y, "demote_after", o.fusion.demote_after);
   read(y, "camera_weight", o.fusion.camera_weight);
@@ -118,6 +137,8 @@ std::string LegPipelineOptions::validate() const {
   if (tracker.hits_to_confirm < 1) return bad("hits_to_confirm", tracker.hits_to_confirm, ">= 1");
   if (tracker.misses_to_delete < 1) return bad("misses_to_delete", tracker.misses_to_delete, ">= 1");
   if (tracker.tentative_misses < 1) return bad("tentative_misses", tracker.tentative_misses, ">= 1");
+  if (!(tracker.velocity_window >= 0.0) || !std::isfinite(tracker.velocity_window))
+    return bad("velocity_window", tracker.velocity_window, "finite and >= 0 s (0: no velocity)");
   if (fusion.promote_after < 1) return bad("promote_after", fusion.promote_after, ">= 1");
   if (fusion.demote_after < 1) return bad("demote_after", fusion.demote_after, ">= 1");
   if (!(fusion.camera_weight > 0.0)) return bad("camera_weight", fusion.camera_weight, "> 0");
@@ -188,10 +209,12 @@ std::vector<TrackedPerson> LegPipeline::track(const std::string& source_frame, d
   const auto& tracks = tracker->second.update(stamp, positions);
   std::vector<int> track_of(people.size(), -1);
   std::vector<bool> confirmed(people.size(), false);
+  std::vector<std::optional<Eigen::Vector2d>> velocity_of(people.size());
   for (const auto& t : tracks)
     if (t.updated && t.detection >= 0) {
       track_of[t.detection] = t.id;
       confirmed[t.detection] = t.confirmed;
+      if (t.has_window_velocity) velocity_of[t.detection] = t.window_velocity;
     }
   // Camera fusion (Algorithm 4): the candidates in the camera's horizontal frame, one cone per box.
   std::vector<FusionCandidate> candidates;
@@ -216,6 +239,7 @@ std::vector<TrackedPerson> LegPipeline::track(const std::string& source_frame, d
     t.confidence = fused[i].confidence;
     t.track_id = track_of[i];
     t.camera_confirmed = cam;
+    t.velocity = velocity_of[i];
     out.push_back(std::move(t));
   }
   return out;
@@ -322,6 +346,7 @@ core::Observation LegPipeline::observation(const TrackedPerson& person, const to
   obs.identifying = false;
   obs.position = person.position;
   obs.position_covariance = Eigen::Matrix2d::Identity() * person.variance;
+  obs.velocity = person.velocity;
   core::setGaussianLikelihood(obs, map, person.position, obs.position_covariance);
   return obs;
 }

@@ -855,9 +855,17 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
     result.reinitialised = true;
     ++counters_.reinitialisations;
   }
-  const bool overlap = weightAndResample(obs, max_l);  // Alg. 1 l. 10-11
+  // TpfParams::anonymous_min_support: a person naming no picker whom the particles barely explain is someone
+  // else (their equal weights below), not a reason to pull the cloud onto its few stray particles.
+  const bool someone_else =
+      !obs.identifying && !belief_.reinitialised && mean_l < params_.anonymous_min_support;
+  const bool overlap = weightAndResample(obs, max_l, someone_else);  // Alg. 1 l. 10-11
   for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
-  if (!overlap) {
+  if (someone_else) {
+    ++counters_.someone_else;
+    result.reason =
+        "an unidentified person the particles barely explain (anonymous_min_support): someone else";
+  } else if (!overlap) {
     ++counters_.no_overlap;
     result.reason = "no overlap between the observation and the particles: resampled with equal weights";
   }
@@ -866,7 +874,8 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   belief_.unconnected_jump_probability = unconnected_p_;
 }
 
-bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood) {
+bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood,
+                                                  bool equal_weights) {
   // Eq. 8 per particle (as particleWeight(), constants hoisted) with the Eq. 9 masses accumulated in
   // node_scratch_b_ in the same pass; Eq. 10 MAP; Eqs. 11-12. Returns false when every weight was 0.
   const double inv_max = 1.0 / max_likelihood;
@@ -901,7 +910,9 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     else
       deposit(n, w);
   };
-  if (!velocity_term) {
+  if (equal_weights) {
+    // the !overlap branch below
+  } else if (!velocity_term) {
     for (std::size_t i = 0; i < particles_.size(); ++i) {
       const NodeIndex n = particles_[i].node;
       accumulate(i, n, node_term(i, n));

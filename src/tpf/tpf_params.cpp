@@ -76,6 +76,8 @@ std::string TpfParams::validate() const {
     return core::badValue("stand_rate", stand_rate, "finite and >= 0");
   if (!(walk_rate > 0.0) || !std::isfinite(walk_rate))
     return core::badValue("walk_rate", walk_rate, "finite and > 0");
+  if (!(anonymous_min_support >= 0.0 && anonymous_min_support <= 1.0))
+    return core::badValue("anonymous_min_support", anonymous_min_support, "in [0, 1]");
   if (!(turn_projection_fraction >= 0.0 && turn_projection_fraction <= 1.0))
     return core::badValue("turn_projection_fraction", turn_projection_fraction, "in [0, 1]");
   if (!(min_jump_dwell > 0.0) || !std::isfinite(min_jump_dwell))
@@ -175,6 +177,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "reverse_rate",
                                                 "stand_rate",
                                                 "walk_rate",
+                                                "anonymous_min_support",
                                                 "lane_change_model",
                                                 "lane_change_leak",
                                                 "lane_change_max_hops",
@@ -250,6 +253,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "reverse_rate", p.reverse_rate);
   read(node, "stand_rate", p.stand_rate);
   read(node, "walk_rate", p.walk_rate);
+  read(node, "anonymous_min_support", p.anonymous_min_support);
   read(node, "lane_change_model", p.lane_change_model);
   read(node, "lane_change_leak", p.lane_change_leak);
   read(node, "lane_change_max_hops", p.lane_change_max_hops);
@@ -307,6 +311,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.velocity_weight_product = false;
     p.reverse_rate = 0.0;
     p.stand_rate = 0.0;
+    p.anonymous_min_support = 0.0;
     p.lane_change_model = false;
     p.jsd_monitor = true;
     p.reinit_fraction = 1.0;

@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 
+#include <deque>
+#include <utility>
 #include <vector>
 
 namespace picker_localisation {
@@ -17,6 +19,10 @@ struct ClusterTrackerOptions {
   int misses_to_delete = 5;     // T_o: scans without an update before a track is removed
   int tentative_misses = 1;     // a tentative track missing this many scans is dropped at once
   double velocity_smoothing = 0.5;  // weight of the newest finite-difference velocity (0..1]
+  // Not in Antonucci 2022: the track's displacement over about this many seconds (window_velocity), the
+  // walking velocity of a person whose legs swing; 0: none. A scan-to-scan difference of a leg pair's
+  // centroid is mostly the legs' swing (several m/s at 10 Hz).
+  double velocity_window = 2.0;  // s
   int first_id = 0;             // ids are first_id, first_id + 1, ... (several trackers can keep ids disjoint)
 };
 
@@ -24,6 +30,11 @@ struct ClusterTrack {
   int id = -1;                       // stable id, unique for the tracker's life
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   Eigen::Vector2d velocity = Eigen::Vector2d::Zero();  // m/s, smoothed finite difference
+  // m/s, (newest - oldest position) / their stamps' span over the last velocity_window; set only once the
+  // span covers half the window (has_window_velocity).
+  Eigen::Vector2d window_velocity = Eigen::Vector2d::Zero();
+  bool has_window_velocity = false;
+  std::deque<std::pair<double, Eigen::Vector2d>> recent;  // (stamp, position) of the updates in the window
   int hits = 0;                      // updates so far
   int misses = 0;                    // consecutive scans without an update
   bool confirmed = false;            // track_j of Algorithm 1
@@ -45,6 +56,9 @@ class ClusterTracker {
   void reset();
 
  private:
+  // Appends the track's new position to its window and updates window_velocity.
+  void remember(ClusterTrack& t, double stamp) const;
+
   ClusterTrackerOptions options_;
   std::vector<ClusterTrack> tracks_;
   int next_id_ = 0;

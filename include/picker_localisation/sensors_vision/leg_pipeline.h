@@ -84,6 +84,9 @@ struct TrackedPerson {
   double confidence = 0.0;
   int track_id = -1;
   bool camera_confirmed = false;
+  // m/s: the track's displacement over the tracker's velocity_window (ClusterTrack::window_velocity); none
+  // until the track spans half the window, or with velocity_window 0.
+  std::optional<Eigen::Vector2d> velocity;
 };
 
 class LegPipeline {
@@ -125,7 +128,8 @@ class LegPipeline {
                                                        const std::string& robot_id);
 
   // The non-identifying Observation of one output person (sensor "lidar": the TPF picks its gamma by kind; a
-  // camera-confirmed cluster is still a LiDAR position, with a tighter covariance).
+  // camera-confirmed cluster is still a LiDAR position, with a tighter covariance), with the track's velocity
+  // when it has one (the TPF's Eq. 8 velocity term, gamma_v of the sensor).
   static core::Observation observation(const TrackedPerson& person, const topology::TopologicalMap& map,
                                        double stamp, const std::string& robot_id);
 

@@ -107,6 +107,7 @@ struct UpdateResult {
 struct FilterCounters {
   std::uint64_t accepted = 0, reordered = 0, dropped_too_old = 0, ignored_sensor = 0, rejected_invalid = 0;
   std::uint64_t reinitialisations = 0, predictions = 0, no_overlap = 0;
+  std::uint64_t someone_else = 0;  // anonymous observations left unweighed (TpfParams::anonymous_min_support)
 };
 
 // The belief after the last update or prediction.
@@ -210,7 +211,8 @@ class TopologicalParticleFilter {
   void jumpAlong(Particle& p, std::uint32_t arc, double pr, double tau, topology::NodeIndex path_next);
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
-  bool weightAndResample(const core::Observation& obs, double max_likelihood);  // false: no overlap
+  // false: no overlap; equal_weights: the observation is not weighed (the no-overlap resampling)
+  bool weightAndResample(const core::Observation& obs, double max_likelihood, bool equal_weights = false);
   // GNSS bias state: predictive density of the fix per particle (into weights_, scaled to max 1), then the
   // per-particle Kalman update of b. Only for observations with usesBiasState(sensor), a position and a
   // prior.

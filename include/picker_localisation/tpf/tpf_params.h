@@ -84,6 +84,13 @@ struct TpfParams {
   // (paper).
   double stand_rate = 0.005;
   double walk_rate = 0.05;
+  // Anonymous people (not in the paper, whose LiDAR people reach every tracker): an observation that names no
+  // picker (identifying false; gnss_ingest's candidates for it) and that the particles explain with a mean
+  // L / max L below this (0.001: less than one particle of 1000 at its peak) is taken to be someone else, and
+  // leaves the belief as a no-overlap update does; otherwise the few particles its likelihood's tail reaches
+  // take the whole cloud. Higher values (0.005) also refused the sightings that pull a lost belief into its
+  // picker's lane (docs/readme/tpf.md). 0: every anonymous observation weighs the particles (paper).
+  double anonymous_min_support = 0.001;
   // Lane-change structure of the farm (not in the paper; Polvara et al. 2021, Sec. VI: pickers walk on into the
   // adjacent lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
   // non-lane nodes to the nearest end of the adjacent lane on each side (at most lane_change_max_hops hops).
