@@ -318,10 +318,10 @@ TEST(LegPipelineOptions, ReadsKeysRejectsBadValuesAndNamesUnknownKeys) {
   ASSERT_EQ(unknown.size(), 1u);  // scan_topics is a node key: known
   EXPECT_NE(unknown[0].find("'leg_treshold'"), std::string::npos) << unknown[0];
   EXPECT_NE(unknown[0].find("'leg_threshold'"), std::string::npos) << unknown[0];
-  for (const char* bad :
-       {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}", "{hits_to_confirm: 0}",
-        "{leg_threshold: abc}", "{negative_p_detect: 1.0}", "{negative_range_max: 2.0}",
-        "{negative_period: -1}", "{negative_clearance: -0.5}", "{velocity_window: -1}"}) {
+  for (const char* bad : {"{leg_threshold: -1}", "{min_cluster_points: -3}", "{position_sigma: 0}",
+                          "{hits_to_confirm: 0}", "{leg_threshold: abc}", "{negative_p_detect: 1.0}",
+                          "{negative_range_max: 2.0}", "{negative_period: -1}", "{negative_clearance: -0.5}",
+                          "{velocity_window: -1}", "{velocity_window: 1e9}"}) {
     try {
       LegPipelineOptions::fromYaml(YAML::Load(bad));
       ADD_FAILURE() << bad << " accepted";

@@ -20,7 +20,8 @@ void ClusterTracker::remember(ClusterTrack& t, double stamp) const {
   if (!(window > 0.0) || !std::isfinite(stamp)) return;
   if (!t.recent.empty() && !(stamp > t.recent.back().first)) t.recent.clear();  // a stamp back: start again
   t.recent.emplace_back(stamp, t.position);
-  // Keep the newest update at least `window` old, so the span covers the window once the track is that old.
+  // Drop the oldest while the next one is at least `window` old: the oldest kept is then at least `window`
+  // old (the span covers the window once the track is that old).
   while (t.recent.size() > 2 && stamp - t.recent[1].first >= window) t.recent.pop_front();
   const double span = stamp - t.recent.front().first;
   t.has_window_velocity = span >= 0.5 * window;
