@@ -137,8 +137,8 @@ std::string LegPipelineOptions::validate() const {
   if (tracker.hits_to_confirm < 1) return bad("hits_to_confirm", tracker.hits_to_confirm, ">= 1");
   if (tracker.misses_to_delete < 1) return bad("misses_to_delete", tracker.misses_to_delete, ">= 1");
   if (tracker.tentative_misses < 1) return bad("tentative_misses", tracker.tentative_misses, ">= 1");
-  if (!(tracker.velocity_window >= 0.0 &&
-        tracker.velocity_window <= 60.0))  // a track keeps its window's scans
+  // Bounded: a track keeps every scan of its window.
+  if (!(tracker.velocity_window >= 0.0 && tracker.velocity_window <= 60.0))
     return bad("velocity_window", tracker.velocity_window, "in [0, 60] s (0: no velocity)");
   if (fusion.promote_after < 1) return bad("promote_after", fusion.promote_after, ">= 1");
   if (fusion.demote_after < 1) return bad("demote_after", fusion.demote_after, ">= 1");

@@ -857,8 +857,8 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   }
   // TpfParams::anonymous_min_support: a person naming no picker whom the particles barely explain is someone
   // else (their equal weights below), not a reason to pull the cloud onto its few stray particles.
-  const bool someone_else =
-      !obs.identifying && !belief_.reinitialised && mean_l < params_.anonymous_min_support;
+  // (Only an identifying observation re-initialises, above.)
+  const bool someone_else = !obs.identifying && mean_l < params_.anonymous_min_support;
   const bool overlap = weightAndResample(obs, max_l, someone_else);  // Alg. 1 l. 10-11
   for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
   if (someone_else) {
