@@ -459,6 +459,14 @@ TEST(PickerAssociation, ClearDetectionsIdentifyAmbiguousOnesStayAnonymous) {
     // Anonymous, for the three trackers it may concern.
     EXPECT_FALSE(a.concerns_nobody);
     EXPECT_EQ(a.observation.candidate_pickers.size(), 3u);
+    // Each with its association probability, for its tracker's PDA update.
+    ASSERT_EQ(a.observation.candidate_probabilities.size(), 3u);
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t i = static_cast<std::size_t>(a.observation.candidate_pickers[k].back() - '1');
+      EXPECT_DOUBLE_EQ(a.observation.candidate_probabilities[k], a.probabilities[i]);
+      EXPECT_DOUBLE_EQ(core::associationProbability(a.observation, a.observation.candidate_pickers[k]),
+                       a.probabilities[i]);
+    }
     EXPECT_TRUE(core::concernsPicker(a.observation, "picker_2"));
     EXPECT_FALSE(core::concernsPicker(a.observation, "picker_9"));
   }

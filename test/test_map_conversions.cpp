@@ -101,7 +101,21 @@ TEST(ObservationConversions, RoundTripAndUnknownNodes) {
   EXPECT_DOUBLE_EQ(back.position_covariance(1, 1), 3.0);
   EXPECT_DOUBLE_EQ(back.position_covariance(0, 1), 0.1);
   EXPECT_EQ(core::validateObservation(back, map), "");
+  // An anonymous person's candidates and their association probabilities come through.
+  obs.identifying = false;
+  obs.picker_id.clear();
+  obs.sensor = "lidar";
+  obs.candidate_pickers = {"picker_1", "picker_2"};
+  obs.candidate_probabilities = {0.25, 0.5};
+  back = ros_adapter::fromMsg(ros_adapter::toMsg(obs, map), map);
+  EXPECT_EQ(back.candidate_pickers, obs.candidate_pickers);
+  EXPECT_EQ(back.candidate_probabilities, obs.candidate_probabilities);
+  EXPECT_EQ(core::validateObservation(back, map), "");
   // Lists of different lengths are caught by validation.
+  back.candidate_probabilities.pop_back();
+  EXPECT_NE(core::validateObservation(back, map).find("candidate_probabilities"), std::string::npos);
+  back.candidate_probabilities = {0.25, 1.5};
+  EXPECT_NE(core::validateObservation(back, map), "");
   msg.likelihood.pop_back();
   msg.likelihood.pop_back();
   EXPECT_NE(core::validateObservation(ros_adapter::fromMsg(msg, map), map), "");

@@ -979,6 +979,38 @@ TEST(TpfAnonymous, AnUnidentifiedPersonTheParticlesBarelyExplainIsSomeoneElse) {
   EXPECT_NE(bad.validate().find("anonymous_min_support"), std::string::npos);
 }
 
+TEST(TpfAnonymous, AnUnidentifiedPersonPullsAsMuchMassAsItsAssociationProbability) {
+  // Half the particles at n2, half at n20 (a first fix of two equal modes). A person naming nobody is seen at
+  // n20, and the association says it is this picker with probability rho. The PDA update (Bar-Shalom and Tse
+  // 1975) mixes "this picker" (all mass to n20) and "someone else" (the belief as it was) at rho : 1 - rho,
+  // so n20 ends with rho + (1 - rho) m, m its mass before (0.6 for rho 0.2 and m 0.5). Taken as certain (the
+  // paper, or the option off) it takes it all; an identifying observation ignores the probability.
+  auto map = laneMap(40, 3.0);
+  struct Masses {
+    double before, after;
+  };
+  auto atThePerson = [&](bool weigh, double rho, bool identifying) {
+    TpfParams p = staticParams(2000);
+    p.weigh_anonymous_by_association = weigh;
+    TopologicalParticleFilter f(map, p, 9);
+    EXPECT_TRUE(f.update(obsAt(0.0, {2, 20}, {0.5, 0.5})).ok());
+    Masses m{nodeFractions(f.particles())[20], 0.0};
+    EXPECT_NEAR(m.before, 0.5, 0.05);
+    EXPECT_TRUE(f.update(obsAt(1.0, {20}, {1.0}, identifying, "lidar"), rho).ok());
+    m.after = nodeFractions(f.particles())[20];
+    return m;
+  };
+  for (double rho : {0.2, 0.7}) {
+    const Masses m = atThePerson(true, rho, false);
+    EXPECT_NEAR(m.after, rho + (1.0 - rho) * m.before, 0.04) << rho;
+  }
+  EXPECT_GT(atThePerson(true, 1.0, false).after, 0.99);
+  EXPECT_GT(atThePerson(false, 0.2, false).after, 0.99);  // the option off: certain
+  EXPECT_GT(atThePerson(true, 0.2, true).after, 0.99);    // identified: certain
+  EXPECT_FALSE(TpfParams::presetForMethod("paper_tpf").weigh_anonymous_by_association);
+  EXPECT_TRUE(TpfParams().weigh_anonymous_by_association);
+}
+
 TEST(TpfMapUpdate, ParticlesFollowTheEditedMap) {
   auto before = polytunnel();
   TopologicalParticleFilter f(before, TpfParams(), 7);

@@ -3,6 +3,7 @@
 // arrives), the belief listener, remove / reset / adoptMap.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +75,45 @@ TEST(TrackerFleet, RoutesByIdentityCandidatesOrToEveryone) {
   // Anonymous, no candidates: everyone.
   EXPECT_EQ(fleet.process(seenAt(3.0, 4, "")).size(), 3u);
   EXPECT_EQ(fleet.find("b")->received, 2u);
+}
+
+TEST(TrackerFleet, GivesEachCandidateItsAssociationProbability) {
+  // Two trackers whose beliefs sit half at node 3 and half at node 40; a person at node 40 that is "a" with
+  // probability 0.9 and "c" with 0.1 (gnss_ingest's candidate_probabilities). Each tracker weighs it by its
+  // own probability, so a's belief moves to node 40 far more than c's.
+  auto map = polytunnel();
+  TrackerFleet fleet(map);
+  for (const char* id : {"a", "c"}) ASSERT_NE(fleet.add(id, params(0.0), 7), nullptr);
+  core::Observation split = seenAt(1.0, 3, "");
+  split.nodes = {3, 40};
+  split.likelihood = {1.0, 1.0};
+  fleet.process(split);
+  core::Observation person = seenAt(2.0, 40, "");
+  person.sensor = "lidar";
+  person.candidate_pickers = {"a", "c"};
+  person.candidate_probabilities = {0.9, 0.1};
+  EXPECT_DOUBLE_EQ(core::associationProbability(person, "a"), 0.9);
+  EXPECT_DOUBLE_EQ(core::associationProbability(person, "c"), 0.1);
+  EXPECT_DOUBLE_EQ(core::associationProbability(person, "b"), 0.0);
+  ASSERT_EQ(fleet.process(person).size(), 2u);
+  const double a = fleet.find("a")->filter->belief().massOf(40),
+               c = fleet.find("c")->filter->belief().massOf(40);
+  EXPECT_GT(a, 0.85);
+  EXPECT_LT(c, 0.75);
+  EXPECT_GT(a - c, 0.25);
+  // Probabilities that do not match the candidates are a malformed observation: refused, the belief kept.
+  person.stamp = 3.0;
+  person.candidate_probabilities = {0.9};
+  const auto outcomes = fleet.process(person);
+  ASSERT_EQ(outcomes.size(), 2u);
+  EXPECT_EQ(outcomes[0].result.status, tpf::UpdateStatus::kRejectedInvalid);
+  EXPECT_NE(outcomes[0].result.reason.find("candidate_probabilities"), std::string::npos);
+  person.candidate_probabilities = {0.9, std::nan("")};
+  EXPECT_EQ(fleet.process(person)[0].result.status, tpf::UpdateStatus::kRejectedInvalid);
+  // Without probabilities every candidate takes the person as its picker (and an identified one too).
+  person.candidate_probabilities.clear();
+  EXPECT_DOUBLE_EQ(core::associationProbability(person, "c"), 1.0);
+  EXPECT_DOUBLE_EQ(core::associationProbability(seenAt(1.0, 3, "b"), "b"), 1.0);
 }
 
 TEST(TrackerFleet, PredictsOnTheScheduleWhateverWhenItIsAsked) {

@@ -85,6 +85,12 @@ std::string validateObservation(const Observation& obs, const topology::Topologi
   }
   if (!(total > 0.0)) return "likelihood sums to zero";
   if (obs.velocity && !obs.velocity->allFinite()) return "velocity is not finite";
+  if (!obs.candidate_probabilities.empty()) {
+    if (obs.candidate_probabilities.size() != obs.candidate_pickers.size())
+      return "candidate_probabilities and candidate_pickers differ in length";
+    for (double p : obs.candidate_probabilities)
+      if (!(p >= 0.0 && p <= 1.0)) return "a candidate probability is not in [0, 1]";
+  }
   if (obs.position && (!obs.position->allFinite() || !obs.position_covariance.allFinite()))
     return "position or its covariance is not finite";
   if (obs.position && !isCovariance2d(obs.position_covariance))
@@ -113,6 +119,13 @@ bool concernsPicker(bool identifying, const std::string& identified,
 
 bool concernsPicker(const Observation& obs, const std::string& picker_id) {
   return concernsPicker(obs.identifying, obs.picker_id, obs.candidate_pickers, picker_id);
+}
+
+double associationProbability(const Observation& obs, const std::string& picker_id) {
+  if (obs.identifying || obs.candidate_probabilities.empty()) return 1.0;
+  for (std::size_t i = 0; i < obs.candidate_pickers.size() && i < obs.candidate_probabilities.size(); ++i)
+    if (obs.candidate_pickers[i] == picker_id) return std::clamp(obs.candidate_probabilities[i], 0.0, 1.0);
+  return 0.0;
 }
 
 }  // namespace core

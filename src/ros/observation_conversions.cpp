@@ -32,6 +32,7 @@ picker_localisation::Observation toMsg(const core::Observation& obs, const topol
   msg.picker_id = obs.picker_id;
   msg.identifying = obs.identifying;
   msg.candidate_pickers = obs.candidate_pickers;
+  msg.candidate_probabilities = obs.candidate_probabilities;
   msg.nodes.reserve(obs.nodes.size());
   for (topology::NodeIndex n : obs.nodes) msg.nodes.push_back(map.node(n).name);
   msg.likelihood = obs.likelihood;
@@ -68,6 +69,7 @@ core::Observation fromMsg(const picker_localisation::Observation& msg, const top
   obs.picker_id = msg.picker_id;
   obs.identifying = msg.identifying;
   obs.candidate_pickers = msg.candidate_pickers;
+  obs.candidate_probabilities = msg.candidate_probabilities;
   std::size_t unknown = 0;
   const std::size_t n = std::min(msg.nodes.size(), msg.likelihood.size());
   for (std::size_t i = 0; i < n; ++i) {

@@ -174,8 +174,10 @@ void decide(AssociationResult& r, const std::vector<GnssIngest*>& pickers,
   if (pickers.empty() || r.probabilities[best] < o.min_probability) {
     if (o.min_candidate_probability > 0.0 && !pickers.empty()) {
       for (std::size_t i = 0; i < pickers.size(); ++i)
-        if (r.probabilities[i] >= o.min_candidate_probability)
+        if (r.probabilities[i] >= o.min_candidate_probability) {
           r.observation.candidate_pickers.push_back(pickers[i]->pickerId());
+          r.observation.candidate_probabilities.push_back(r.probabilities[i]);
+        }
       r.concerns_nobody = r.observation.candidate_pickers.empty();
     }
     return;

@@ -488,7 +488,7 @@ UpdateResult TopologicalParticleFilter::reject(UpdateStatus status, std::string 
   return r;
 }
 
-UpdateResult TopologicalParticleFilter::update(const core::Observation& obs) {
+UpdateResult TopologicalParticleFilter::update(const core::Observation& obs, double association_probability) {
   if (!params_.acceptsSensor(obs.sensor))
     return reject(UpdateStatus::kIgnoredSensor, "sensor '" + obs.sensor + "' is not fused in this mode");
   const std::string problem = core::validateObservation(obs, *map_);
@@ -511,7 +511,7 @@ UpdateResult TopologicalParticleFilter::update(const core::Observation& obs) {
   } else {
     dt = obs.stamp - belief_.stamp;
   }
-  fuse(obs, dt, result);
+  fuse(obs, dt, result, association_probability);
   if (!params_.usesBiasState(obs.sensor)) other_sensor_stamp_ = std::max(other_sensor_stamp_, obs.stamp);
   if (result.status == UpdateStatus::kReordered)
     ++counters_.reordered;
@@ -826,7 +826,8 @@ double TopologicalParticleFilter::observationJsd(const core::Observation& obs, d
   return std::sqrt(std::clamp(0.5 * s, 0.0, 1.0));
 }
 
-void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, UpdateResult& result) {
+void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, UpdateResult& result,
+                                     double association_probability) {
   predict(dt);  // Alg. 1 l. 4
 
   double sum_l = 0.0, max_l = 0.0;
@@ -859,7 +860,11 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   // else (their equal weights below), not a reason to pull the cloud onto its few stray particles.
   // (Only an identifying observation re-initialises, above.)
   const bool someone_else = !obs.identifying && mean_l < params_.anonymous_min_support;
-  const bool overlap = weightAndResample(obs, max_l, someone_else);  // Alg. 1 l. 10-11
+  // TpfParams::weigh_anonymous_by_association: the probability that a person naming nobody is this picker.
+  const double rho = !obs.identifying && params_.weigh_anonymous_by_association
+                         ? std::clamp(association_probability, 0.0, 1.0)
+                         : 1.0;
+  const bool overlap = weightAndResample(obs, max_l, someone_else || rho <= 0.0, rho);  // Alg. 1 l. 10-11
   for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
   if (someone_else) {
     ++counters_.someone_else;
@@ -875,7 +880,7 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
 }
 
 bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, double max_likelihood,
-                                                  bool equal_weights) {
+                                                  bool equal_weights, double association_probability) {
   // Eq. 8 per particle (as particleWeight(), constants hoisted) with the Eq. 9 masses accumulated in
   // node_scratch_b_ in the same pass; Eq. 10 MAP; Eqs. 11-12. Returns false when every weight was 0.
   const double inv_max = 1.0 / max_likelihood;
@@ -910,20 +915,34 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     else
       deposit(n, w);
   };
+  // TpfParams::weigh_anonymous_by_association, the PDA update (Bar-Shalom and Tse 1975): with probability rho
+  // the person is this picker (particle i's Eq. 8 weight w_i), else someone else (the same weight for every
+  // particle, the mean of w), so the two hypotheses keep rho : 1 - rho of the mass. Two passes: the mean
+  // first.
+  const bool mixed = association_probability < 1.0;
+  auto weigh = [&](auto&& weight_of) {
+    if (!mixed) {
+      for (std::size_t i = 0; i < particles_.size(); ++i) accumulate(i, particles_[i].node, weight_of(i));
+      return;
+    }
+    double sum = 0.0;
+    for (std::size_t i = 0; i < particles_.size(); ++i) sum += (weights_[i] = weight_of(i));
+    const double someone_else = (1.0 - association_probability) / association_probability * sum /
+                                static_cast<double>(particles_.size());
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+      accumulate(i, particles_[i].node, weights_[i] + (sum > 0.0 ? someone_else : 0.0));
+  };
   if (equal_weights) {
     // the !overlap branch below
   } else if (!velocity_term) {
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
-      const NodeIndex n = particles_[i].node;
-      accumulate(i, n, node_term(i, n));
-    }
+    weigh([&](std::size_t i) { return node_term(i, particles_[i].node); });
   } else {
     const float ox = static_cast<float>(obs.velocity->x()), oy = static_cast<float>(obs.velocity->y());
     const float vs = std::sqrt(ox * ox + oy * oy);
     const float inv_sigma = 1.0f / static_cast<float>(std::max(0.5 * vs, params_.min_velocity_sigma));
     const float gv4 = static_cast<float>(0.25 * gamma.velocity);
     const bool product = params_.velocity_weight_product;
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
+    weigh([&](std::size_t i) {
       const Particle& p = particles_[i];
       const float speed = p.standing ? 0.0f : std::sqrt(p.vx * p.vx + p.vy * p.vy);
       const float z = (speed - vs) * inv_sigma;
@@ -931,8 +950,8 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
       const float cosang = denom > 1e-12f ? (p.vx * ox + p.vy * oy) / denom : 0.0f;
       const double wq = node_term(i, p.node);
       const double wv = static_cast<double>(gv4 * (std::exp(-0.5f * z * z) + 0.5f * (cosang + 1.0f)));
-      accumulate(i, p.node, product ? wq * (1.0 + wv) : wq + wv);
-    }
+      return product ? wq * (1.0 + wv) : wq + wv;
+    });
   }
   const bool overlap = total > 0.0 && std::isfinite(total);
   if (!overlap) {

@@ -178,6 +178,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "stand_rate",
                                                 "walk_rate",
                                                 "anonymous_min_support",
+                                                "weigh_anonymous_by_association",
                                                 "lane_change_model",
                                                 "lane_change_leak",
                                                 "lane_change_max_hops",
@@ -254,6 +255,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "stand_rate", p.stand_rate);
   read(node, "walk_rate", p.walk_rate);
   read(node, "anonymous_min_support", p.anonymous_min_support);
+  read(node, "weigh_anonymous_by_association", p.weigh_anonymous_by_association);
   read(node, "lane_change_model", p.lane_change_model);
   read(node, "lane_change_leak", p.lane_change_leak);
   read(node, "lane_change_max_hops", p.lane_change_max_hops);
@@ -312,6 +314,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.reverse_rate = 0.0;
     p.stand_rate = 0.0;
     p.anonymous_min_support = 0.0;
+    p.weigh_anonymous_by_association = false;
     p.lane_change_model = false;
     p.jsd_monitor = true;
     p.reinit_fraction = 1.0;

@@ -74,7 +74,7 @@ TrackerFleet::Outcome TrackerFleet::process(Track& t, const core::Observation& o
   ++t.received;
   try {
     if (std::isfinite(obs.stamp)) predictDue(t, obs.stamp);
-    out.result = t.filter->update(obs);
+    out.result = t.filter->update(obs, core::associationProbability(obs, t.id));
   } catch (const std::exception& e) {
     caught(t, e);
     out.exception = true;

@@ -23,6 +23,9 @@ struct Observation {
   // Not identifying: the pickers it may concern, e.g. those an anonymous person could be (association
   // probability above a floor); empty = every picker (paper Sec. VI: anonymous observations reach every filter).
   std::vector<std::string> candidate_pickers;
+  // Parallel to candidate_pickers, or empty: the association probability that the observation is each of them
+  // (gnss_ingest's p_i). A tracker weighs the observation by it (TpfParams::weigh_anonymous_by_association).
+  std::vector<double> candidate_probabilities;
   std::vector<topology::NodeIndex> nodes;  // support of the likelihood (unique indices)
   std::vector<double> likelihood;          // >= 0, one per entry of nodes; need not sum to 1
   std::optional<Eigen::Vector2d> velocity;  // m/s, map frame
@@ -46,6 +49,11 @@ bool concernsPicker(const Observation& obs, const std::string& picker_id);
 // The same rule on the fields (for a message, before converting it).
 bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
                     const std::string& picker_id);
+
+// The probability that the observation is `picker_id` for that picker's filter: 1 when it identifies the
+// picker or when it carries no probabilities (the observation is simply given to the filter), else the
+// candidate's entry of candidate_probabilities (0 when the picker is not a candidate).
+double associationProbability(const Observation& obs, const std::string& picker_id);
 
 // Negative-information form: every node of a map of `num_nodes` listed, with likelihood 1 (the caller then
 // lowers the nodes the evidence concerns, e.g. an antenna that did not read, a laser that saw nobody).

@@ -134,8 +134,10 @@ class TopologicalParticleFilter {
                             std::uint64_t seed);
 
   // Algorithm 1 for one observation. Never throws on bad input: returns the status and reason instead and
-  // leaves the belief untouched.
-  UpdateResult update(const core::Observation& obs);
+  // leaves the belief untouched. association_probability: the probability that an observation naming no
+  // picker is this filter's picker (core::associationProbability; TpfParams::weigh_anonymous_by_association);
+  // ignored for identifying observations.
+  UpdateResult update(const core::Observation& obs, double association_probability = 1.0);
   // Prediction only (Eqs. 2-7) to `stamp` (periodic prediction). No-op returning false before the first
   // observation or when stamp is not after the last update.
   bool predictTo(double stamp);
@@ -212,7 +214,9 @@ class TopologicalParticleFilter {
   double observationJsd(const core::Observation& obs, double sum_likelihood, double max_likelihood,
                         double* mean_likelihood);
   // false: no overlap; equal_weights: the observation is not weighed (the no-overlap resampling)
-  bool weightAndResample(const core::Observation& obs, double max_likelihood, bool equal_weights = false);
+  // association_probability < 1: a PDA update (TpfParams::weigh_anonymous_by_association).
+  bool weightAndResample(const core::Observation& obs, double max_likelihood, bool equal_weights = false,
+                         double association_probability = 1.0);
   // GNSS bias state: predictive density of the fix per particle (into weights_, scaled to max 1), then the
   // per-particle Kalman update of b. Only for observations with usesBiasState(sensor), a position and a
   // prior.
@@ -249,7 +253,7 @@ class TopologicalParticleFilter {
   void chooseMapNodeByLane();  // TpfParams::map_node_by_lane
   void addNoise();
   void recordBelief(bool counted);
-  void fuse(const core::Observation& obs, double dt, UpdateResult& result);
+  void fuse(const core::Observation& obs, double dt, UpdateResult& result, double association_probability);
 
   std::shared_ptr<const topology::TopologicalMap> map_;
   std::shared_ptr<const MotionGraph> graph_;
