@@ -927,10 +927,11 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
     }
     double sum = 0.0;
     for (std::size_t i = 0; i < particles_.size(); ++i) sum += (weights_[i] = weight_of(i));
-    const double someone_else = (1.0 - association_probability) / association_probability * sum /
-                                static_cast<double>(particles_.size());
+    const double someone_else_weight = sum > 0.0 ? (1.0 - association_probability) / association_probability *
+                                                       sum / static_cast<double>(particles_.size())
+                                                 : 0.0;  // 0: no overlap, handled below
     for (std::size_t i = 0; i < particles_.size(); ++i)
-      accumulate(i, particles_[i].node, weights_[i] + (sum > 0.0 ? someone_else : 0.0));
+      accumulate(i, particles_[i].node, weights_[i] + someone_else_weight);
   };
   if (equal_weights) {
     // the !overlap branch below

@@ -94,9 +94,10 @@ struct TpfParams {
   // Anonymous people weighed by their association probability (not in the paper; the probabilistic data
   // association update, Bar-Shalom and Tse 1975): an observation naming no picker that gnss_ingest found to
   // be this picker with probability rho (Observation::candidate_probabilities) weighs particle i by (1 - rho)
-  // mean_j L_j + rho L_i, the likelihood of "someone else, or this picker", so after the update the mass its
-  // likelihood pulls is rho, not 1. Off: every candidate's tracker takes the person as certainly its picker
-  // (the paper's anonymous observations). Observations without probabilities are taken as certain.
+  // mean_j w_j + rho w_i (w the Eq. 8 weight), the likelihood of "someone else, or this picker", so after the
+  // update the mass its likelihood pulls is rho, not 1. Off: every candidate's tracker takes the person as
+  // certainly its picker (the paper's anonymous observations). Observations without probabilities are taken
+  // as certain.
   bool weigh_anonymous_by_association = true;
   // Lane-change structure of the farm (not in the paper; Polvara et al. 2021, Sec. VI: pickers walk on into the
   // adjacent lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
