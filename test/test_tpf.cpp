@@ -783,6 +783,7 @@ TEST(TpfGnssBias, AReportedRowMovesTheBeliefIntoItWeighedAgainstTheFixes) {
     p.lane_swap_rate = 0.0;  // the moves of the reported row only
     p.jsd_monitor = false;
     p.lane_evidence_sweeps = sweeps;
+    p.lane_evidence_projection = false;  // the swap moves alone (the projection: the next test)
     TopologicalParticleFilter f(map, p, 23);
     EXPECT_TRUE(f.update(obsAt(0.0, {here}, {1.0}, true, "uwb")).ok());
     for (int k = 1; k <= 60; ++k)
@@ -810,6 +811,62 @@ TEST(TpfGnssBias, AReportedRowMovesTheBeliefIntoItWeighedAgainstTheFixes) {
   const auto [tight_here, tight_row, tight_beyond] = afterReport(4, 0.05);
   EXPECT_GT(tight_here, 0.95);
   EXPECT_LT(tight_row + tight_beyond, 0.05);
+}
+
+TEST(TpfGnssBias, AReportedRowMovesTheParticlesAcrossKeepingWhereAlongTheLane) {
+  // A minute of phone fixes on lane 5 holds every particle there. The picker reports lane 7, two lanes over
+  // (likelihood 1 there, 0.2 elsewhere). With the projection each particle moves across into lane 7 with
+  // probability 1 - 0.2, to the same place along it: lane 7 holds ~0.8, lane 5 keeps ~0.2, and the moved mass
+  // sits across from where the fixes put the picker, not spread along the row. Then the fixes go on: with the
+  // phone's wide prior they cannot tell the lanes apart and the row holds; with a tight prior (a robot
+  // measured the bias) they rule out the 3 m shift and take the belief back to lane 5. Weighting alone
+  // (projection off) leaves lane 7 empty.
+  auto map = polytunnel();
+  const NodeIndex here = *map->index("r5_5"), row = *map->index("r7_5");
+  struct Masses {
+    double here_lane, row_lane, row_node_and_neighbours, row_lane_later;
+  };
+  auto afterReport = [&](bool projection, double prior_variance) {
+    TpfParams p = staticParams(1000);
+    p.gnss_bias_state = true;
+    p.lane_swap_rate = 0.0;  // the row's moves only
+    p.jsd_monitor = false;
+    p.lane_evidence_projection = projection;
+    TopologicalParticleFilter f(map, p, 29);
+    EXPECT_TRUE(f.update(obsAt(0.0, {here}, {1.0}, true, "uwb")).ok());
+    auto fix = [&](double t) {
+      return biasedFix(*map, t, map->position2d(here), 9.0, {0.0, 0.0}, prior_variance, 2.0 * 6.25 / 300.0);
+    };
+    for (int k = 1; k <= 60; ++k) EXPECT_TRUE(f.update(fix(k)).ok());
+    core::Observation reported = obsAt(61.0, {}, {}, true, "reported_row");
+    for (NodeIndex n = 0; n < map->numNodes(); ++n) {
+      reported.nodes.push_back(n);
+      reported.likelihood.push_back(map->lane(n) == map->lane(row) ? 1.0 : 0.2);
+    }
+    EXPECT_TRUE(f.update(reported).ok());
+    Masses m{};
+    m.here_lane = laneMass(*map, f.belief(), here);
+    m.row_lane = laneMass(*map, f.belief(), row);
+    for (std::size_t j = 0; j < f.belief().nodes.size(); ++j) {
+      const NodeIndex n = f.belief().nodes[j];
+      if (map->lane(n) == map->lane(row) && (map->position2d(n) - map->position2d(row)).norm() < 3.5)
+        m.row_node_and_neighbours += f.belief().masses[j];
+    }
+    for (int k = 62; k <= 91; ++k) EXPECT_TRUE(f.update(fix(k)).ok());
+    m.row_lane_later = laneMass(*map, f.belief(), row);
+    return m;
+  };
+  const Masses off = afterReport(false, 10.25);
+  EXPECT_LT(off.row_lane, 1e-3);
+  EXPECT_GT(off.here_lane, 0.999);
+  const Masses wide = afterReport(true, 10.25);
+  EXPECT_NEAR(wide.row_lane, 0.8, 0.05);
+  EXPECT_NEAR(wide.here_lane, 0.2, 0.05);
+  EXPECT_GT(wide.row_node_and_neighbours, 0.9 * wide.row_lane);  // across from the fixes, not along the row
+  EXPECT_GT(wide.row_lane_later, 0.7);  // measured 0.805: the fixes cannot tell the lanes apart
+  const Masses tight = afterReport(true, 0.05);
+  EXPECT_NEAR(tight.row_lane, 0.8, 0.05);
+  EXPECT_LT(tight.row_lane_later, 0.05);
 }
 
 TEST(TpfGnssBias, AConstantBiasOfALaneSpacingDoesNotMoveTheLane) {

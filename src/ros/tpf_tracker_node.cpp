@@ -602,6 +602,7 @@ void TpfTracker::diagnose(Track& t, diagnostic_updater::DiagnosticStatusWrapper&
   stat.add("re-initialisations", c.reinitialisations);
   stat.add("no-overlap updates", c.no_overlap);
   stat.add("unidentified people taken for someone else", c.someone_else);
+  stat.add("reported rows that moved particles across", c.lane_evidence_projections);
   stat.add("predictions", c.predictions);
   stat.add("what-if calls", t.what_if_calls);
   stat.add("resets", core.resets);

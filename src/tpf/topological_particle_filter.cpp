@@ -314,7 +314,8 @@ void TopologicalParticleFilter::useMap(std::shared_ptr<const topology::Topologic
       *map, params_.directed_motion,
       params_.lane_change_model && params_.motion_model == MotionModel::kVelocity,
       params_.lane_change_max_hops,
-      (params_.gnss_bias_state && params_.lane_swap_rate > 0.0) || params_.lane_evidence_sweeps > 0
+      (params_.gnss_bias_state && params_.lane_swap_rate > 0.0) || params_.lane_evidence_sweeps > 0 ||
+              params_.lane_evidence_projection
           ? params_.lane_swap_max_distance
           : 0.0);
   std::vector<double> edge(std::max<std::size_t>(1, graph->max_degree), 0.0);
@@ -856,6 +857,20 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
     result.reinitialised = true;
     ++counters_.reinitialisations;
   }
+  if (params_.lane_evidence_projection && obs.identifying && params_.isLaneEvidence(obs.sensor) &&
+      !result.reinitialised && !result.initialised && max_l > 0.0) {
+    // TpfParams::lane_evidence_projection: the evidence moves the particles; no weighting follows.
+    const std::size_t moved = projectOntoLaneEvidence(max_l);
+    for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
+    recordBelief(false);
+    if (moved > 0) {
+      ++counters_.lane_evidence_projections;
+      result.reason = std::to_string(moved) + " particles moved across into the lane the evidence names";
+    }
+    if (params_.entropy_gate && belief_.entropy < params_.entropy_threshold) unconnected_p_ = 0.0;
+    belief_.unconnected_jump_probability = unconnected_p_;
+    return;
+  }
   // TpfParams::anonymous_min_support: a person naming no picker whom the particles barely explain is someone
   // else (their equal weights below), not a reason to pull the cloud onto its few stray particles.
   // (Only an identifying observation re-initialises, above.)
@@ -980,7 +995,8 @@ bool TopologicalParticleFilter::weightAndResample(const core::Observation& obs, 
 
   resample(total);  // Eq. 11
   if (bias_state) swapLanes(obs);
-  const bool moved = params_.isLaneEvidence(obs.sensor) && moveTowardsLaneEvidence();
+  const bool moved =
+      params_.lane_evidence_sweeps > 0 && params_.isLaneEvidence(obs.sensor) && moveTowardsLaneEvidence();
   addNoise();   // Eq. 12, leaves the particle counts per node in node_scratch_b_ / touched_
   if (moved) {  // the belief is the moved particles' (the weights above were those before the moves)
     recordBelief(true);
@@ -1093,6 +1109,19 @@ bool TopologicalParticleFilter::swapsRun(const core::Observation& obs) const {
   return !(obs.stamp - other_sensor_stamp_ < params_.lane_swap_memory);
 }
 
+NodeIndex TopologicalParticleFilter::nextAcross(NodeIndex previous, NodeIndex current) const {
+  // The next lane in the same direction: the swap neighbour of `current` away from `previous`.
+  const Eigen::Vector2d at = map_->position2d(current), step = at - map_->position2d(previous);
+  NodeIndex next = topology::kInvalidNode;
+  for (int s = 0; s < 2; ++s) {
+    const NodeIndex candidate = graph_->across[2 * current + s];
+    if (candidate != topology::kInvalidNode && candidate != previous &&
+        (map_->position2d(candidate) - at).dot(step) > 0.0)
+      next = candidate;
+  }
+  return next;
+}
+
 template <typename Deposit>
 void TopologicalParticleFilter::shareOverLanes(const Particle& p, double weight, const SwapPrior& prior,
                                                Deposit&& deposit) const {
@@ -1123,15 +1152,7 @@ void TopologicalParticleFilter::shareOverLanes(const Particle& p, double weight,
       const double ratio = std::exp(std::min(log_ratio, 50.0));
       across_lanes[count++] = {current, ratio};
       sum += ratio;
-      // The next lane in the same direction: the neighbour of `current` away from `previous`.
-      const Eigen::Vector2d step = at - map_->position2d(previous);
-      NodeIndex next = topology::kInvalidNode;
-      for (int s = 0; s < 2; ++s) {
-        const NodeIndex candidate = graph_->across[2 * current + s];
-        if (candidate != topology::kInvalidNode && candidate != previous &&
-            (map_->position2d(candidate) - at).dot(step) > 0.0)
-          next = candidate;
-      }
+      const NodeIndex next = nextAcross(previous, current);
       previous = current;
       current = next;
     }
@@ -1194,6 +1215,43 @@ bool TopologicalParticleFilter::moveTowardsLaneEvidence() {
       applySwap(p, to, shift);
       moved = true;
     }
+  return moved;
+}
+
+std::size_t TopologicalParticleFilter::projectOntoLaneEvidence(double max_likelihood) {
+  // TpfParams::lane_evidence_projection. node_scratch_a_ holds L (0 off the observation's nodes). A particle
+  // whose L is below the max moves with probability 1 - L / max L to the nearest node, in lanes crossed
+  // through the swap neighbours on either side, whose L is the max (fewer lanes crossed first; a tie is
+  // broken at random), its bias shifted as a swap shifts it. Particles on a lane-change path, off the lanes
+  // or with no such node within kMaxLanes lanes stay.
+  if (graph_->across.empty()) return 0;
+  constexpr int kMaxLanes = 24;
+  std::size_t moved = 0;
+  for (Particle& p : particles_) {
+    const double l = node_scratch_a_[p.node];
+    if (p.lane_change != 0 || !(l < max_likelihood) || uniform01(rng_) < l / max_likelihood) continue;
+    std::array<NodeIndex, 2> found{topology::kInvalidNode, topology::kInvalidNode};
+    std::array<int, 2> lanes_crossed{kMaxLanes + 1, kMaxLanes + 1};
+    for (int side = 0; side < 2; ++side) {
+      NodeIndex previous = p.node, current = graph_->across[2 * p.node + side];
+      for (int k = 1; k <= kMaxLanes && current != topology::kInvalidNode; ++k) {
+        if (node_scratch_a_[current] >= max_likelihood) {
+          found[side] = current;
+          lanes_crossed[side] = k;
+          break;
+        }
+        const NodeIndex next = nextAcross(previous, current);
+        previous = current;
+        current = next;
+      }
+    }
+    int side = lanes_crossed[0] < lanes_crossed[1] ? 0 : 1;
+    if (lanes_crossed[0] == lanes_crossed[1]) side = static_cast<int>(rng_() & 1u);
+    const NodeIndex to = found[side];
+    if (to == topology::kInvalidNode) continue;
+    applySwap(p, to, map_->position2d(p.node) - map_->position2d(to));
+    ++moved;
+  }
   return moved;
 }
 

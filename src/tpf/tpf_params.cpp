@@ -43,8 +43,8 @@ bool TpfParams::usesBiasState(const std::string& sensor) const {
 }
 
 bool TpfParams::isLaneEvidence(const std::string& sensor) const {
-  return lane_evidence_sweeps > 0 && std::find(lane_evidence_sensors.begin(), lane_evidence_sensors.end(),
-                                               sensor) != lane_evidence_sensors.end();
+  return std::find(lane_evidence_sensors.begin(), lane_evidence_sensors.end(), sensor) !=
+         lane_evidence_sensors.end();
 }
 
 std::string TpfParams::validate() const {
@@ -202,6 +202,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "lane_swap_memory",
                                                 "lane_evidence_sensors",
                                                 "lane_evidence_sweeps",
+                                                "lane_evidence_projection",
                                                 "map_node_by_lane",
                                                 "lane_masses_by_swap_prior",
                                                 "resampling",
@@ -279,6 +280,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "lane_swap_memory", p.lane_swap_memory);
   read(node, "lane_evidence_sensors", p.lane_evidence_sensors);
   read(node, "lane_evidence_sweeps", p.lane_evidence_sweeps);
+  read(node, "lane_evidence_projection", p.lane_evidence_projection);
   read(node, "map_node_by_lane", p.map_node_by_lane);
   read(node, "lane_masses_by_swap_prior", p.lane_masses_by_swap_prior);
   if (node["method"]) {  // mode switches win
@@ -315,6 +317,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.stand_rate = 0.0;
     p.anonymous_min_support = 0.0;
     p.weigh_anonymous_by_association = false;
+    p.lane_evidence_projection = false;
     p.lane_change_model = false;
     p.jsd_monitor = true;
     p.reinit_fraction = 1.0;

@@ -108,6 +108,8 @@ struct FilterCounters {
   std::uint64_t accepted = 0, reordered = 0, dropped_too_old = 0, ignored_sensor = 0, rejected_invalid = 0;
   std::uint64_t reinitialisations = 0, predictions = 0, no_overlap = 0;
   std::uint64_t someone_else = 0;  // anonymous observations left unweighed (TpfParams::anonymous_min_support)
+  std::uint64_t lane_evidence_projections =
+      0;  // lane evidence that moved particles (lane_evidence_projection)
 };
 
 // The belief after the last update or prediction.
@@ -228,6 +230,9 @@ class TopologicalParticleFilter {
   // swap move with the observation's likelihood (node_scratch_a_) in the acceptance. True when a particle
   // moved.
   bool moveTowardsLaneEvidence();
+  // TpfParams::lane_evidence_projection: moves particles across into the lane whose nodes have the max
+  // likelihood (node_scratch_a_); returns how many moved.
+  std::size_t projectOntoLaneEvidence(double max_likelihood);
   // The device prior both lane moves weigh a shifted bias with (the last fix with the bias state): its mean,
   // 1 / 2P and the path term's Q / 8P^2; all 0 before such a fix.
   struct SwapPrior {
@@ -247,6 +252,9 @@ class TopologicalParticleFilter {
   // deposit(node, mass).
   template <typename Deposit>
   void shareOverLanes(const Particle& p, double weight, const SwapPrior& prior, Deposit&& deposit) const;
+  // Walking across the lanes through the swap neighbours: the node one lane beyond `current` in the direction
+  // from `previous` to `current`; kInvalidNode at the last lane.
+  topology::NodeIndex nextAcross(topology::NodeIndex previous, topology::NodeIndex current) const;
   // Moves a particle to `to` with its bias (and bias path) shifted by `shift`.
   static void applySwap(Particle& p, topology::NodeIndex to, const Eigen::Vector2d& shift);
   void resample(double total_weight);

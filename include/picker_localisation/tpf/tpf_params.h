@@ -163,12 +163,23 @@ struct TpfParams {
   // observation's likelihood ratio L(n') / L(n) times the device prior's ratio of the two biases and of their
   // recent paths: a Metropolis-Hastings kernel whose invariant law is the posterior (resample-move, Gilks and
   // Berzuini 2001), so the lanes' mass follows the reported row and the GNSS evidence together (a mistyped
-  // row next to a strongly-held lane does not win outright). 0 sweeps (default): weighting only. Measured
-  // off: with a row on every call (10 % a neighbour's) 4 sweeps gave no fewer wrong-lane entries than
-  // weighting alone (docs/readme/tpf.md, "A reported row").
+  // row next to a strongly-held lane does not win outright). 0 sweeps (default): none (the projection below
+  // moves the belief). Measured off: with a row on every call (10 % a neighbour's) 4 sweeps gave no fewer
+  // wrong-lane entries than weighting alone (docs/readme/tpf.md, "A reported row").
   std::vector<std::string> lane_evidence_sensors{"reported_row"};
   int lane_evidence_sweeps = 0;
-  bool isLaneEvidence(const std::string& sensor) const;
+  // Lane evidence moves particles instead of weighing them: each particle outside the evidence's lane (L
+  // below its max) moves across, lane after lane through the swap neighbours, to the same place along that
+  // lane with probability 1 - L(n) / max L, its bias shifted so that it predicts the same fixes; the others
+  // stay and no weighting follows. The belief then holds the reported row with at least 1 - floor of its
+  // mass, a mixture of "the row is right" (the belief moved, its along-lane place kept) and "the row is
+  // mistyped" (the belief as it was), whatever the belief held before. Weighting cannot lift a lane no
+  // particle holds, and the swap moves above, accepted against a device prior a wrong identity had made
+  // tight, could not either (docs/readme/tpf.md, "A reported row"). The fixes that follow still weigh the
+  // moved particles: a bias measured by a robot pulls a belief moved against it back within seconds, a stale
+  // one does not.
+  bool lane_evidence_projection = true;
+  bool isLaneEvidence(const std::string& sensor) const;  // one of lane_evidence_sensors
   // The decision (Eq. 10's n*, the tracker's current_node, a dispatch target) by lane first, coarse to fine:
   // in a lane or not (the two totals), then the lane holding the most mass and its node of most mass, or else
   // the off-lane node of most mass. Eq. 10 literally (false) takes the single node of most mass: where the
