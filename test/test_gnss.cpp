@@ -336,6 +336,32 @@ TEST(GnssBiasEstimator, RestartsFromRefusedSightingsThatAgree) {
   EXPECT_LT((b.bias(100.0) - wrong).norm(), 2.0);
 }
 
+TEST(GnssBiasEstimator, ASightingThatIsThePickerOnlyWithProbabilityBetaMovesTheEstimateBetaOfTheWay) {
+  // PDAF with one validated measurement (Bar-Shalom and Tse 1975): the mean moves beta of the certain
+  // update's way, and the covariance keeps (1 - beta) of the prediction plus the spread between the two
+  // hypotheses.
+  const Eigen::Vector2d y(2.0, -1.0);
+  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.25;
+  GnssBiasEstimator certain, half, sure;
+  ASSERT_TRUE(certain.update(0.0, y, R).accepted);
+  ASSERT_TRUE(half.update(0.0, y, R, 0.5).accepted);
+  ASSERT_TRUE(sure.update(0.0, y, R, 1.0).accepted);
+  EXPECT_LT((sure.bias(0.0) - certain.bias(0.0)).norm(), 1e-12);
+  EXPECT_LT((half.bias(0.0) - 0.5 * certain.bias(0.0)).norm(), 1e-9);
+  const GnssBiasEstimator prior;
+  const double p0 = prior.covariance(0.0)(0, 0), p1 = certain.covariance(0.0)(0, 0);
+  // Per axis (scalar in H x): beta (1 - beta) (k nu)^2 on top of the mix of prior and updated variance.
+  const double k_nu = certain.bias(0.0)(0);
+  EXPECT_NEAR(half.covariance(0.0)(0, 0), 0.5 * p0 + 0.5 * p1 + 0.25 * k_nu * k_nu, 1e-9);
+  EXPECT_GT(half.covariance(0.0)(0, 0), p1);
+  // Many half-sure sightings of one bias still converge on it, only more slowly.
+  for (int k = 1; k < 40; ++k) ASSERT_TRUE(half.update(k, y, R, 0.5).accepted);
+  EXPECT_LT((half.bias(39.0) - y).norm(), 0.3);
+  EXPECT_FALSE(half.update(40.0, y, R, 0.0).accepted);
+  EXPECT_FALSE(half.update(40.0, y, R, 1.5).accepted);
+  EXPECT_FALSE(half.update(40.0, y, R, std::nan("")).accepted);
+}
+
 TEST(GnssBiasEstimator, ConvergesOnAConstantBiasThenRelaxesToTheOffset) {
   GnssBiasEstimator b;
   std::mt19937_64 rng(7);
@@ -439,9 +465,28 @@ TEST(PickerAssociation, ClearDetectionsIdentifyAmbiguousOnesStayAnonymous) {
   EXPECT_TRUE(a.observation.identifying);
   EXPECT_EQ(a.observation.picker_id, "picker_2");
   EXPECT_GE(a.probabilities[1], 0.9);
+  // The named picker is its one candidate, at the probability it was named with (the TPF's
+  // weigh_named_by_association); every other picker's filter gets 0.
+  EXPECT_EQ(a.observation.candidate_pickers, std::vector<std::string>{"picker_2"});
+  ASSERT_EQ(a.observation.candidate_probabilities.size(), 1u);
+  EXPECT_DOUBLE_EQ(a.observation.candidate_probabilities[0], a.probabilities[1]);
+  EXPECT_DOUBLE_EQ(core::associationProbability(a.observation, "picker_2"), a.probabilities[1]);
+  EXPECT_DOUBLE_EQ(core::associationProbability(a.observation, "picker_1"), 0.0);
   EXPECT_TRUE(a.bias.accepted) << a.bias.reason;
   EXPECT_TRUE(f.ingest[1].bias().sighted());
   EXPECT_FALSE(f.ingest[0].bias().sighted());
+  // Named at below association_sighting_min_probability: named, but no bias sighting.
+  {
+    ThreeLanes g;
+    PickerAssociationOptions strict;
+    strict.sighting_min_probability = 1.0;
+    g.fixes(1.0, {{-15.0, 0.0}, {0.0, 1.5}, {15.0, 3.0}});
+    const AssociationResult named =
+        associatePerson(g.person(1.2, {0.3, 1.2}), g.pickers, {}, *g.fx.map, strict);
+    EXPECT_EQ(named.observation.picker_id, "picker_2");
+    EXPECT_FALSE(named.bias.accepted);
+    EXPECT_FALSE(g.ingest[1].bias().sighted());
+  }
   // Far from everybody: clutter, anonymous.
   a = associatePerson(f.person(1.3, {0.0, -15.0}), f.pickers, {}, *f.fx.map, o);
   EXPECT_EQ(a.picker, -1);

@@ -1046,9 +1046,10 @@ TEST(TpfAnonymous, AnUnidentifiedPersonPullsAsMuchMassAsItsAssociationProbabilit
   struct Masses {
     double before, after;
   };
-  auto atThePerson = [&](bool weigh, double rho, bool identifying) {
+  auto atThePerson = [&](bool weigh, double rho, bool identifying, bool weigh_named = false) {
     TpfParams p = staticParams(2000);
     p.weigh_anonymous_by_association = weigh;
+    p.weigh_named_by_association = weigh_named;
     TopologicalParticleFilter f(map, p, 9);
     EXPECT_TRUE(f.update(obsAt(0.0, {2, 20}, {0.5, 0.5})).ok());
     Masses m{nodeFractions(f.particles())[20], 0.0};
@@ -1064,7 +1065,13 @@ TEST(TpfAnonymous, AnUnidentifiedPersonPullsAsMuchMassAsItsAssociationProbabilit
   EXPECT_GT(atThePerson(true, 1.0, false).after, 0.99);
   EXPECT_GT(atThePerson(false, 0.2, false).after, 0.99);  // the option off: certain
   EXPECT_GT(atThePerson(true, 0.2, true).after, 0.99);    // identified: certain
+  // weigh_named_by_association: a person the association named this picker at 0.8 pulls 0.8 of the mass.
+  const Masses named = atThePerson(true, 0.8, true, true);
+  EXPECT_NEAR(named.after, 0.8 + 0.2 * named.before, 0.04);
+  EXPECT_GT(atThePerson(false, 0.8, false, true).after,
+            0.99);  // anonymous with only the named option: certain
   EXPECT_FALSE(TpfParams::presetForMethod("paper_tpf").weigh_anonymous_by_association);
+  EXPECT_FALSE(TpfParams::presetForMethod("paper_tpf").weigh_named_by_association);
   EXPECT_TRUE(TpfParams().weigh_anonymous_by_association);
 }
 

@@ -122,10 +122,11 @@ bool concernsPicker(const Observation& obs, const std::string& picker_id) {
 }
 
 double associationProbability(const Observation& obs, const std::string& picker_id) {
-  if (obs.identifying || obs.candidate_probabilities.empty()) return 1.0;
+  if (obs.candidate_probabilities.empty()) return 1.0;
+  if (obs.identifying && obs.picker_id != picker_id) return 0.0;
   for (std::size_t i = 0; i < obs.candidate_pickers.size() && i < obs.candidate_probabilities.size(); ++i)
     if (obs.candidate_pickers[i] == picker_id) return std::clamp(obs.candidate_probabilities[i], 0.0, 1.0);
-  return 0.0;
+  return obs.identifying ? 1.0 : 0.0;
 }
 
 }  // namespace core

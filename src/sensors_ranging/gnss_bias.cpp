@@ -134,7 +134,8 @@ Eigen::Matrix2d GnssBiasEstimator::appliedCovariance(double t) const {
   return usable(t) ? covariance(t) : options_.priorCovariance();
 }
 
-BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const Eigen::Matrix2d& R) {
+BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const Eigen::Matrix2d& R,
+                                     double probability) {
   BiasUpdate u;
   auto refuse = [&](const std::string& why) {
     u.reason = why;
@@ -142,6 +143,7 @@ BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const E
     return u;
   };
   if (!std::isfinite(t) || !y.allFinite() || !R.allFinite()) return refuse("sighting is NaN/Inf");
+  if (!(probability > 0.0 && probability <= 1.0)) return refuse("sighting probability is not in (0, 1]");
   if (sighted() && t < last_) return refuse("sighting is older than the last one used");
   Eigen::Matrix<double, 4, 1> x;
   Eigen::Matrix4d P;
@@ -177,10 +179,21 @@ BiasUpdate GnssBiasEstimator::update(double t, const Eigen::Vector2d& y, const E
   }
   refused_recent_.clear();
   const Eigen::Matrix<double, 4, 2> K = P * H.transpose() * S_inv;
-  x_ = x + K * u.innovation;
-  // Joseph form keeps P symmetric positive definite.
-  const Eigen::Matrix4d I_KH = Eigen::Matrix4d::Identity() - K * H;
-  P_ = I_KH * P * I_KH.transpose() + K * R * K.transpose();
+  if (probability < 1.0) {
+    // PDAF (Bar-Shalom and Tse 1975) with one validated measurement of probability beta: the mean moves beta
+    // of the way, and the covariance keeps (1 - beta) of the prediction plus the spread of the two
+    // hypotheses.
+    const double beta = probability;
+    const Eigen::Matrix<double, 4, 1> Kv = K * u.innovation;
+    x_ = x + beta * Kv;
+    P_ = P - beta * (K * S * K.transpose()) + beta * (1.0 - beta) * (Kv * Kv.transpose());
+    P_ = 0.5 * (P_ + P_.transpose());
+  } else {
+    x_ = x + K * u.innovation;
+    // Joseph form keeps P symmetric positive definite.
+    const Eigen::Matrix4d I_KH = Eigen::Matrix4d::Identity() - K * H;
+    P_ = I_KH * P * I_KH.transpose() + K * R * K.transpose();
+  }
   last_ = t;
   ++sightings_;
   u.accepted = true;

@@ -88,6 +88,8 @@ PickerAssociationOptions PickerAssociationOptions::fromYaml(const YAML::Node& y)
   core::readOption(y, c, "association_speed", o.speed);
   core::readOption(y, c, "association_max_belief_age", o.max_belief_age);
   core::readOption(y, c, "association_belief_lag", o.belief_lag);
+  core::readOption(y, c, "association_sighting_min_probability", o.sighting_min_probability);
+  core::readOption(y, c, "association_weigh_sightings", o.weigh_sightings);
   core::readOption(y, c, "association_min_candidate_probability", o.min_candidate_probability);
   core::readOption(y, c, "association_identity_sensors", o.identity_sensors);
   core::readOption(y, c, "association_identity_window", o.identity_window);
@@ -107,6 +109,8 @@ const std::vector<std::string>& PickerAssociationOptions::yamlKeys() {
                                                 "association_speed",
                                                 "association_max_belief_age",
                                                 "association_belief_lag",
+                                                "association_sighting_min_probability",
+                                                "association_weigh_sightings",
                                                 "association_min_candidate_probability",
                                                 "association_identity_sensors",
                                                 "association_identity_window",
@@ -120,6 +124,8 @@ std::string PickerAssociationOptions::validate() const {
     return bad("association_clutter_density", clutter_density, "finite and > 0");
   if (!(min_probability > 0.5 && min_probability <= 1.0))
     return bad("association_min_probability", min_probability, "in (0.5, 1]");
+  if (!(sighting_min_probability >= 0.0 && sighting_min_probability <= 1.0))
+    return bad("association_sighting_min_probability", sighting_min_probability, "in [0, 1]");
   if (!(min_candidate_probability >= 0.0 && min_candidate_probability < min_probability))
     return bad("association_min_candidate_probability", min_candidate_probability,
                "in [0, association_min_probability)");
@@ -340,7 +346,7 @@ GnssResult GnssIngest::process(const core::GnssFix& fix) {
 }
 
 BiasUpdate GnssIngest::addSighting(double stamp, const Eigen::Vector2d& position,
-                                   const Eigen::Matrix2d& covariance) {
+                                   const Eigen::Matrix2d& covariance, double probability) {
   BiasUpdate u;
   if (!options_.bias.enabled) {
     u.reason = "bias estimation is disabled";
@@ -356,7 +362,7 @@ BiasUpdate GnssIngest::addSighting(double stamp, const Eigen::Vector2d& position
   const double gap = std::abs(nearest->stamp - stamp);
   const double r = options_.bias.residual_std, m = options_.bias.pairing_speed * gap;
   const Eigen::Matrix2d R = covariance + (r * r + m * m) * Eigen::Matrix2d::Identity();
-  return bias_.update(stamp, nearest->position - position, R);
+  return bias_.update(stamp, nearest->position - position, R, probability);
 }
 
 GnssIngest::Prediction GnssIngest::predictPosition(double t, double speed, double max_age) const {

@@ -185,9 +185,18 @@ void decide(AssociationResult& r, const std::vector<GnssIngest*>& pickers,
   r.picker = static_cast<int>(best);
   r.observation.identifying = true;
   r.observation.picker_id = pickers[best]->pickerId();
+  const double p = r.probabilities[best];
+  // The named picker as the one candidate, with its probability (the TPF's weigh_named_by_association).
+  r.observation.candidate_pickers = {r.observation.picker_id};
+  r.observation.candidate_probabilities = {p};
+  if (p < o.sighting_min_probability) {
+    r.bias.reason = "association probability below association_sighting_min_probability";
+    return;
+  }
   r.bias = pickers[best]->addSighting(
       r.observation.stamp, *r.observation.position,
-      0.5 * (r.observation.position_covariance + r.observation.position_covariance.transpose()));
+      0.5 * (r.observation.position_covariance + r.observation.position_covariance.transpose()),
+      o.weigh_sightings ? p : 1.0);
 }
 
 // Marginals of the joint association (associatePeople's comment) of people whose l rows are `l`.

@@ -875,10 +875,11 @@ void TopologicalParticleFilter::fuse(const core::Observation& obs, double dt, Up
   // else (their equal weights below), not a reason to pull the cloud onto its few stray particles.
   // (Only an identifying observation re-initialises, above.)
   const bool someone_else = !obs.identifying && mean_l < params_.anonymous_min_support;
-  // TpfParams::weigh_anonymous_by_association: the probability that a person naming nobody is this picker.
-  const double rho = !obs.identifying && params_.weigh_anonymous_by_association
-                         ? std::clamp(association_probability, 0.0, 1.0)
-                         : 1.0;
+  // TpfParams::weigh_anonymous_by_association / weigh_named_by_association: the probability that the person
+  // is this picker.
+  const bool weigh_by_association =
+      obs.identifying ? params_.weigh_named_by_association : params_.weigh_anonymous_by_association;
+  const double rho = weigh_by_association ? std::clamp(association_probability, 0.0, 1.0) : 1.0;
   const bool overlap = weightAndResample(obs, max_l, someone_else || rho <= 0.0, rho);  // Alg. 1 l. 10-11
   for (NodeIndex n : obs.nodes) node_scratch_a_[n] = 0.0;
   if (someone_else) {

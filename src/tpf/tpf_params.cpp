@@ -179,6 +179,7 @@ const std::vector<std::string>& TpfParams::yamlKeys() {
                                                 "walk_rate",
                                                 "anonymous_min_support",
                                                 "weigh_anonymous_by_association",
+                                                "weigh_named_by_association",
                                                 "lane_change_model",
                                                 "lane_change_leak",
                                                 "lane_change_max_hops",
@@ -257,6 +258,7 @@ TpfParams TpfParams::fromYaml(const YAML::Node& node, std::vector<std::string>* 
   read(node, "walk_rate", p.walk_rate);
   read(node, "anonymous_min_support", p.anonymous_min_support);
   read(node, "weigh_anonymous_by_association", p.weigh_anonymous_by_association);
+  read(node, "weigh_named_by_association", p.weigh_named_by_association);
   read(node, "lane_change_model", p.lane_change_model);
   read(node, "lane_change_leak", p.lane_change_leak);
   read(node, "lane_change_max_hops", p.lane_change_max_hops);
@@ -317,6 +319,7 @@ TpfParams TpfParams::presetForMethod(const std::string& method, const TpfParams&
     p.stand_rate = 0.0;
     p.anonymous_min_support = 0.0;
     p.weigh_anonymous_by_association = false;
+    p.weigh_named_by_association = false;
     p.lane_evidence_projection = false;
     p.lane_change_model = false;
     p.jsd_monitor = true;

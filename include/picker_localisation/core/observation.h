@@ -21,7 +21,8 @@ struct Observation {
   std::string picker_id;         // identified picker; empty when !identifying
   bool identifying = false;
   // Not identifying: the pickers it may concern, e.g. those an anonymous person could be (association
-  // probability above a floor); empty = every picker (paper Sec. VI: anonymous observations reach every filter).
+  // probability above a floor); empty = every picker (paper Sec. VI: anonymous observations reach every
+  // filter). A person the association named: picker_id alone, with the probability it was named at.
   std::vector<std::string> candidate_pickers;
   // Parallel to candidate_pickers, or empty: the association probability that the observation is each of them
   // (gnss_ingest's p_i). A tracker weighs the observation by it (TpfParams::weigh_anonymous_by_association).
@@ -50,9 +51,10 @@ bool concernsPicker(const Observation& obs, const std::string& picker_id);
 bool concernsPicker(bool identifying, const std::string& identified, const std::vector<std::string>& candidates,
                     const std::string& picker_id);
 
-// The probability that the observation is `picker_id` for that picker's filter: 1 when it identifies the
-// picker or when it carries no probabilities (the observation is simply given to the filter), else the
-// candidate's entry of candidate_probabilities (0 when the picker is not a candidate).
+// The probability that the observation is `picker_id` for that picker's filter: the candidate's entry of
+// candidate_probabilities (0 when the picker is not a candidate); 1 when the observation carries no
+// probabilities (it is simply given to the filter), or identifies the picker without listing it (a tag read).
+// A people detection the association named carries its picker and that probability as its one candidate.
 double associationProbability(const Observation& obs, const std::string& picker_id);
 
 // Negative-information form: every node of a map of `num_nodes` listed, with likelihood 1 (the caller then

@@ -86,7 +86,11 @@ class GnssBiasEstimator {
 
   // Kalman update with a measured bias y (m, map frame) of covariance R at time t (s). Refused (state
   // unchanged) when t is before the last sighting, y/R not finite, or the innovation fails the gate.
-  BiasUpdate update(double t, const Eigen::Vector2d& measured_bias, const Eigen::Matrix2d& covariance);
+  // `probability` < 1: the sighting is of this picker only with that probability (a people detection the
+  // association named); the update is the probabilistic data association filter's for one validated
+  // measurement (Bar-Shalom and Tse 1975): x += beta K nu, P -= beta K S K^T - beta (1 - beta) K nu nu^T K^T.
+  BiasUpdate update(double t, const Eigen::Vector2d& measured_bias, const Eigen::Matrix2d& covariance,
+                    double probability = 1.0);
   // Predicted bias and its covariance at time t (>= the last sighting; earlier t gives the state at it).
   Eigen::Vector2d bias(double t) const;
   Eigen::Matrix2d covariance(double t) const;

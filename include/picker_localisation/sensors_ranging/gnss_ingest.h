@@ -42,6 +42,10 @@ struct PickerAssociationOptions {
   double clutter_density = 5e-4;     // 1/m^2, density of people detections that are no listed picker (false
                                      // legs, other workers): the "nobody we track" hypothesis
   double min_probability = 0.8;      // association probability at which a detection identifies its picker
+  double sighting_min_probability = 0.0;  // a named detection is a bias sighting of its picker only at this
+                                          // probability or more (below min_probability: every named one)
+  bool weigh_sightings =
+      false;  // a bias sighting from a named detection weighs in with its probability (PDAF)
   double min_candidate_probability = 0.05;  // an unidentified detection reaches the trackers of the pickers
                                      // with at least this probability (0: every tracker, as the paper)
   double belief_weight = 0.5;        // share of the tracker's belief in the picker's predicted position
@@ -147,7 +151,9 @@ class GnssIngest {
   // associated people detection at time `stamp`: pairs it with the raw fix nearest in time (within
   // bias_pairing_gap) and updates the bias estimate with y = fix - position,
   // R = cov + residual_std^2 I + (pairing_speed * gap)^2 I.
-  BiasUpdate addSighting(double stamp, const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance);
+  // `probability`: that the sighting is this picker's (GnssBiasEstimator::update).
+  BiasUpdate addSighting(double stamp, const Eigen::Vector2d& position, const Eigen::Matrix2d& covariance,
+                         double probability = 1.0);
 
   // Where the GNSS says the picker is at time t: the latest accepted fix minus the bias estimate, with
   // covariance P_bias(t) + residual_std^2 I + (speed * age)^2 I (prior bias covariance before any sighting).

@@ -99,6 +99,11 @@ struct TpfParams {
   // certainly its picker (the paper's anonymous observations). Observations without probabilities are taken
   // as certain.
   bool weigh_anonymous_by_association = true;
+  // The same update for a person the association named this picker (p >= association_min_probability): it
+  // pulls p of the mass, not all, so a wrong name (a neighbour p thought to be this picker) leaves 1 - p
+  // where it was. Off: a named person is certain (the paper's identifying observations). Tag reads are
+  // certain.
+  bool weigh_named_by_association = false;
   // Lane-change structure of the farm (not in the paper; Polvara et al. 2021, Sec. VI: pickers walk on into the
   // adjacent lane). For every lane end the filter finds, from the map's topology alone, the shortest path through
   // non-lane nodes to the nearest end of the adjacent lane on each side (at most lane_change_max_hops hops).
