@@ -25,7 +25,8 @@ struct Observation {
   // filter). A person the association named: picker_id alone, with the probability it was named at.
   std::vector<std::string> candidate_pickers;
   // Parallel to candidate_pickers, or empty: the association probability that the observation is each of them
-  // (gnss_ingest's p_i). A tracker weighs the observation by it (TpfParams::weigh_anonymous_by_association).
+  // (gnss_ingest's p_i). A tracker weighs the observation by it (TpfParams::weigh_anonymous_by_association,
+  // weigh_named_by_association).
   std::vector<double> candidate_probabilities;
   std::vector<topology::NodeIndex> nodes;  // support of the likelihood (unique indices)
   std::vector<double> likelihood;          // >= 0, one per entry of nodes; need not sum to 1

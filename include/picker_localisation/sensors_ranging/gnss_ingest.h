@@ -44,8 +44,8 @@ struct PickerAssociationOptions {
   double min_probability = 0.8;      // association probability at which a detection identifies its picker
   double sighting_min_probability = 0.0;  // a named detection is a bias sighting of its picker only at this
                                           // probability or more (below min_probability: every named one)
-  bool weigh_sightings =
-      false;  // a bias sighting from a named detection weighs in with its probability (PDAF)
+  // A bias sighting from a named detection weighs in with its probability (PDAF, GnssBiasEstimator::update).
+  bool weigh_sightings = false;
   double min_candidate_probability = 0.05;  // an unidentified detection reaches the trackers of the pickers
                                      // with at least this probability (0: every tracker, as the paper)
   double belief_weight = 0.5;        // share of the tracker's belief in the picker's predicted position
