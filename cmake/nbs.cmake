@@ -3,6 +3,7 @@ add_library(picker_localisation_nbs
   src/nbs/choquet.cpp
   src/nbs/belief_source.cpp
   src/nbs/next_best_sense_planner.cpp
+  src/nbs/tray_clock.cpp
   src/nbs/nbs_planner_node_options.cpp)
 target_link_libraries(picker_localisation_nbs PUBLIC picker_localisation_core)
 # The what-if view of a live TPF (in-process planning: experiment runner, tests).

@@ -7,7 +7,8 @@
 # DISPATCHER_CONFIG (config/dispatcher.yaml), SIM_CONFIG (config/sim.yaml: e.g. calls.reported_row_share), JOBS (2),
 # IDLE_ROBOTS (nbs: the planner positions robots serving no call, as nbs_planner does; stay: they wait),
 # SEED (1: runs use seeds SEED .. SEED + RUNS - 1), TPF_CONFIG (config/tpf.yaml), GNSS_CONFIG
-# (config/gnss_ingest.yaml: the association's options).
+# (config/gnss_ingest.yaml: the association's options), NBS_CONFIG (config/nbs.yaml: the planner positioning idle
+# robots, e.g. call_due_weight).
 set -eo pipefail
 cd "$(dirname "$0")/.."
 RUNS="${1:-5}"
@@ -27,7 +28,7 @@ for farm in $FARMS; do
     --seed "${SEED:-1}" --duration "$DURATION" --pickers-count "$PICKERS" --robots "$ROBOTS" --methods "$METHODS" \
     --dispatcher-config "${DISPATCHER_CONFIG:-config/dispatcher.yaml}" --sim-config "${SIM_CONFIG:-config/sim.yaml}" \
     --tpf-config "${TPF_CONFIG:-config/tpf.yaml}" --gnss-config "${GNSS_CONFIG:-config/gnss_ingest.yaml}" \
-    --idle-robots "${IDLE_ROBOTS:-nbs}" --jobs "${JOBS:-2}" --out "$OUT/$farm" \
+    --nbs-config "${NBS_CONFIG:-config/nbs.yaml}" --idle-robots "${IDLE_ROBOTS:-nbs}" --jobs "${JOBS:-2}" --out "$OUT/$farm" \
     > "$OUT/$farm.log" 2>&1 || { echo "experiment failed: $OUT/$farm.log" >&2; exit 1; }
   cat "$OUT/$farm/summary.md"
   echo

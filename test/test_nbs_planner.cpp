@@ -195,3 +195,70 @@ TEST(EstimatedNodePolicy, GoesToTheMapNodeOrTheNearestUnclaimedOne) {
   EXPECT_FALSE(none.ok());
   EXPECT_FALSE(none.problem.empty());
 }
+
+// Call-aware idle positioning: TrayClock's rule, hand-computed.
+TEST(TrayClock, WeightGrowsWithTheTimeSinceTheTraysWereEmptied) {
+  TrayClock clock(4.0, 300.0);
+  // Never called: counted from the first time the clock is asked (the shift's start).
+  EXPECT_DOUBLE_EQ(clock.weight("a", 1000.0), 1.0);
+  EXPECT_DOUBLE_EQ(clock.weight("a", 1150.0), 1.0 + 4.0 * 0.5);
+  EXPECT_DOUBLE_EQ(clock.weight("b", 1150.0), 3.0);    // any picker: the same start
+  EXPECT_DOUBLE_EQ(clock.weight("a", 2000.0), 5.0);    // saturates at a whole tray time
+  clock.observeCall("a", 1900.0, std::nan(""), true);  // calling, no robot there yet: full
+  EXPECT_DOUBLE_EQ(clock.weight("a", 1901.0), 5.0);
+  clock.observeCall("a", 1900.0, 1960.0, true);  // a robot reached it: emptied then
+  EXPECT_DOUBLE_EQ(clock.weight("a", 1960.0), 1.0);
+  EXPECT_DOUBLE_EQ(clock.weight("a", 2020.0), 1.0 + 4.0 * 0.2);
+  clock.observeCall("a", 2100.0, std::nan(""), false);  // a later call cancelled before any robot came
+  EXPECT_DOUBLE_EQ(clock.weight("a", 2110.0), 1.0 + 4.0 * 0.5);  // the trays as they were
+  clock.observeCall("a", 1900.0, 1960.0, false);                 // the older call reported again: no change
+  EXPECT_DOUBLE_EQ(clock.weight("a", 2110.0), 3.0);
+  const PickerWeights w = clock.weights({"a", "b"}, 2110.0);
+  ASSERT_EQ(w.size(), 2u);
+  EXPECT_DOUBLE_EQ(w.at("b"), 5.0);
+  clock.reset();  // the clock jumped back: start again
+  EXPECT_DOUBLE_EQ(clock.weight("a", 10.0), 1.0);
+  // Weight 0: every picker 1 (the planner as before).
+  TrayClock off(0.0, 300.0);
+  off.observeCall("a", 5.0, std::nan(""), true);
+  EXPECT_DOUBLE_EQ(off.weight("a", 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(off.weight("a", 1e6), 1.0);
+  EXPECT_THROW(TrayClock(-1.0, 300.0), std::invalid_argument);
+  EXPECT_THROW(TrayClock(1.0, 0.0), std::invalid_argument);
+}
+
+TEST(NbsPlanner, PickerAboutToCallWeighsMore) {
+  auto map = wideTunnels();
+  // Two equally uncertain pickers in mirror lanes; the robot on the headland between them.
+  StaticBeliefSource left("left", uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 0, 0)))));
+  StaticBeliefSource right("right", uniformOver(*map, map->laneNodes(map->lane(laneNode(*map, 4, 0)))));
+  const NodeIndex robot = *map->index("H2");
+  NextBestSensePlanner planner(map, PlannerConfig{});
+  const PlanResult even = planner.plan(robot, 1.0, {&left, &right});
+  ASSERT_TRUE(even.ok()) << even.problem;
+  for (int k = 0; k < 10; ++k) {  // mirror candidates tie without weights
+    const Candidate* l = find(even, laneNode(*map, 0, k));
+    const Candidate* r = find(even, laneNode(*map, 4, k));
+    ASSERT_TRUE(l && r);
+    EXPECT_NEAR(l->raw[kRfidGain], r->raw[kRfidGain], 1e-12) << "lane node " << k;
+  }
+  // The right picker's trays are nearly full: its gain counts 3x, so the best goal is in its lane.
+  for (const auto& [due, other] : {std::pair<std::string, int>{"right", 4}, {"left", 0}}) {
+    const PlanResult r = planner.plan(robot, 1.0, {&left, &right}, {}, {{due, 3.0}});
+    ASSERT_TRUE(r.ok()) << r.problem;
+    EXPECT_EQ(map->lane(r.ranked.front().node), map->lane(laneNode(*map, other, 0)))
+        << map->node(r.ranked.front().node).name;
+    EXPECT_EQ(r.ranked.front().target_picker, due);
+    const Candidate* c = find(r, laneNode(*map, other, 3));
+    const Candidate* base = find(even, laneNode(*map, other, 3));
+    ASSERT_TRUE(c && base);
+    EXPECT_NEAR(c->raw[kRfidGain], 3.0 * base->raw[kRfidGain], 1e-12);
+  }
+  // The keys, and a bad value refused.
+  const PlannerConfig cfg =
+      PlannerConfig::fromYaml(YAML::Load("{call_due_weight: 4.0, tray_time_mean: 300}"));
+  EXPECT_DOUBLE_EQ(cfg.call_due_weight, 4.0);
+  EXPECT_DOUBLE_EQ(cfg.tray_time_mean, 300.0);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("{call_due_weight: -1}")), std::runtime_error);
+  EXPECT_THROW(PlannerConfig::fromYaml(YAML::Load("{tray_time_mean: 0}")), std::runtime_error);
+}

@@ -9,6 +9,7 @@
 
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseStamped.h>
+#include <picker_localisation/CallStatusArray.h>
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
@@ -307,11 +308,38 @@ TEST(NbsPlannerNode, SubscribesToNoGroundTruthTopic) {
           t == "/pickers/beliefs" || t == "/pickers/registry" ||
           (t.size() > 5 && t.substr(t.size() - 5) == "/goal") ||
           (t.size() > 10 && t.substr(t.size() - 10) == "/call_goal") || t == "/tf" || t == "/tf_static" ||
-          t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery");
+          t == "/clock" || (t.size() > 8 && t.substr(t.size() - 8) == "/battery") ||
+          (t == "/dispatcher/status" && node.find("robot_6") != std::string::npos);  // call_due_weight > 0
       EXPECT_TRUE(allowed) << node << " subscribes to " << t;
     }
+    // Only a planner weighing pickers about to call reads the dispatcher's calls.
+    EXPECT_EQ(topics.count("/dispatcher/status") == 1, node.find("robot_6") != std::string::npos) << node;
   }
-  EXPECT_EQ(planners, 5u);
+  EXPECT_EQ(planners, 6u);
+}
+
+// A planner with call_due_weight > 0 reads the dispatcher's calls (when each picker's trays were emptied).
+TEST(NbsPlannerNode, ReadsTheDispatchersCallsForCallDueWeights) {
+  ros::NodeHandle nh;
+  ros::Subscriber diag = nh.subscribe("/diagnostics", 20, diagnosticsCallback);
+  ros::Publisher status = nh.advertise<picker_localisation::CallStatusArray>("/dispatcher/status", 1, true);
+  picker_localisation::CallStatusArray calls;
+  picker_localisation::CallStatus c;
+  c.call_id = 1;
+  c.picker_id = "picker_1";
+  c.state = "queued";
+  c.called = ros::Time::now();
+  calls.calls.push_back(c);
+  status.publish(calls);
+  EXPECT_TRUE(waitFor([] {
+    const std::string v = diagnosticValue("robot_6", "call status messages");
+    return !v.empty() && std::stoul(v) >= 1;
+  })) << "robot_6 did not count the dispatcher's status";
+  const std::string weight = diagnosticValue("robot_6", "call-due weight");
+  ASSERT_FALSE(weight.empty());
+  EXPECT_DOUBLE_EQ(std::stod(weight), 4.0);
+  EXPECT_TRUE(waitFor([] { return !diagnosticValue("robot_1", "call status messages").empty(); }));
+  EXPECT_EQ(diagnosticValue("robot_1", "call status messages"), "0");  // call_due_weight 0: not subscribed
 }
 
 // A picker the tracker adds at run time (its latched list on /pickers/registry) is planned for: its beliefs on

@@ -331,6 +331,7 @@ class GraphRun {
     nbs::Claim goal;       // the planner's last goal (node kInvalidNode: none)
   };
   std::vector<IdleRobot> idle_;  // calls scenario with idle_robots "nbs", per robot
+  std::unique_ptr<nbs::TrayClock> tray_clock_;  // calls scenario: the pickers' call-due weights
   RunResult result_;
 };
 
@@ -421,6 +422,7 @@ void GraphRun::makePlanner(nbs::Policy policy) {
   }
   pc.policy = policy;
   planner_ = std::make_unique<nbs::NextBestSensePlanner>(map_, pc);
+  tray_clock_ = std::make_unique<nbs::TrayClock>(pc.call_due_weight, pc.tray_time_mean);
   for (const auto& s : scoring_)
     sources_.push_back(std::make_unique<nbs::TpfBeliefSource>(s.id, *trackers_->find(s.id)->filter,
                                                               what_if_seed ? what_if_seed : 1));
@@ -699,10 +701,18 @@ void GraphRun::positionIdleRobots(double now) {
     }
   }
   const std::vector<nbs::BeliefSource*> pickers = views();
+  // The pickers' call-due weights from the dispatcher's calls, as nbs_planner reads them from its ~status.
+  nbs::PickerWeights weights;
+  if (tray_clock_->callDueWeight() > 0.0) {
+    for (const dispatch::Call& c : dispatcher_->calls())
+      tray_clock_->observeCall(c.picker_id, c.stamp, c.arrived_at, c.open());
+    for (const nbs::BeliefSource* p : pickers)
+      weights[p->pickerId()] = tray_clock_->weight(p->pickerId(), now);
+  }
   for (std::size_t r : due) {
     const std::string& id = simulator_.robot(r).id();
-    const nbs::PlanResult plan =
-        planner_->plan(simulator_.robot(r).currentNode(), battery_level_, pickers, nbs::claimsFor(id, goals));
+    const nbs::PlanResult plan = planner_->plan(simulator_.robot(r).currentNode(), battery_level_, pickers,
+                                                nbs::claimsFor(id, goals), weights);
     idle_[r].last_plan = now;
     if (!plan.ok()) continue;
     const nbs::Claim goal{id, plan.ranked.front().node, plan.ranked.front().target_picker};

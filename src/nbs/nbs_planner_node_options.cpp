@@ -32,6 +32,7 @@ const core::OptionTable<NbsPlannerNodeOptions>& table() {
                                             .add("battery_topic", &O::battery_topic)
                                             .add("goal_pose_topic", &O::goal_pose_topic)
                                             .add("call_goal_topic", &O::call_goal_topic)
+                                            .add("call_status_topic", &O::call_status_topic)
                                             .add("belief_topic", &O::fleet, &F::belief_topic)
                                             .add("registry_topic", &O::fleet, &F::registry_topic)
                                             .add("registry_publisher", &O::fleet, &F::registry_publisher);

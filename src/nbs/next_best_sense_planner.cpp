@@ -133,6 +133,9 @@ std::string PlannerConfig::validate() const {
   if (!(claimed_picker_weight >= 0.0 && claimed_picker_weight <= 1.0))
     return "claimed_picker_weight must be in [0, 1]";
   if (claim_exclusion_hops < 0) return "claim_exclusion_hops must be >= 0";
+  if (!(call_due_weight >= 0.0) || !std::isfinite(call_due_weight))
+    return "call_due_weight must be finite and >= 0";
+  if (!positive(tray_time_mean) || !std::isfinite(tray_time_mean)) return "tray_time_mean must be > 0";
   return "";
 }
 
@@ -141,7 +144,7 @@ const std::vector<std::string>& PlannerConfig::yamlKeys() {
   // clang-format off
   static const std::vector<std::string> keys = {
       "policy", "weights", "interactions", "horizon_hops", "horizon_m", "horizon_bucket", "planning_latency", "rfid",
-      "energy", "claimed_picker_weight", "claim_exclusion_hops", "target_picker"};
+      "energy", "claimed_picker_weight", "claim_exclusion_hops", "target_picker", "call_due_weight", "tray_time_mean"};
   // clang-format on
   return keys;
 }
@@ -214,6 +217,8 @@ PlannerConfig PlannerConfig::fromYaml(const YAML::Node& node, std::vector<std::s
   readKey(node, "claimed_picker_weight", c.claimed_picker_weight);
   readKey(node, "claim_exclusion_hops", c.claim_exclusion_hops);
   readKey(node, "target_picker", c.target_picker);
+  readKey(node, "call_due_weight", c.call_due_weight);
+  readKey(node, "tray_time_mean", c.tray_time_mean);
   const std::string problem = c.validate();
   if (!problem.empty()) throw std::runtime_error("nbs config: " + problem);
   return c;
@@ -259,7 +264,8 @@ std::vector<NodeIndex> NextBestSensePlanner::candidateNodes(NodeIndex robot,
 
 PlanResult NextBestSensePlanner::plan(NodeIndex robot_node, double battery_level,
                                       const std::vector<BeliefSource*>& pickers,
-                                      const std::vector<Claim>& claims) const {
+                                      const std::vector<Claim>& claims,
+                                      const PickerWeights& picker_weights) const {
   PlanResult result;
   result.policy = config_.policy;
   if (robot_node >= map_->numNodes()) {
@@ -272,7 +278,7 @@ PlanResult NextBestSensePlanner::plan(NodeIndex robot_node, double battery_level
   }
   return config_.policy == Policy::kEstimatedNode
              ? planEstimatedNode(robot_node, battery_level, pickers, claims)
-             : planNextBestSense(robot_node, battery_level, pickers, claims);
+             : planNextBestSense(robot_node, battery_level, pickers, claims, picker_weights);
 }
 
 // One picker's expected entropy reduction by a sensing stop at c (the rfid_gain criterion, Polvara et al.
@@ -307,7 +313,8 @@ double NextBestSensePlanner::expectedRfidGain(BeliefSource& source, NodeIndex c,
 
 PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double battery,
                                                    const std::vector<BeliefSource*>& pickers,
-                                                   const std::vector<Claim>& claims) const {
+                                                   const std::vector<Claim>& claims,
+                                                   const PickerWeights& picker_weights) const {
   PlanResult result;
   result.policy = Policy::kNextBestSense;
   result.criteria = criterionNames();
@@ -323,7 +330,8 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     return result;
   }
 
-  // Picker weights: pickers served by a higher-priority robot count claimed_picker_weight.
+  // Picker weights: pickers served by a higher-priority robot count claimed_picker_weight, times the
+  // call-due weight (TrayClock).
   std::set<std::string> claimed_pickers;
   for (const Claim& c : claims)
     if (!c.picker_id.empty()) claimed_pickers.insert(c.picker_id);
@@ -338,6 +346,7 @@ PlanResult NextBestSensePlanner::planNextBestSense(NodeIndex robot, double batte
     PickerState p;
     p.source = s;
     p.weight = claimed_pickers.count(s->pickerId()) ? config_.claimed_picker_weight : 1.0;
+    if (const auto w = picker_weights.find(s->pickerId()); w != picker_weights.end()) p.weight *= w->second;
     states.push_back(std::move(p));
   }
 

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "picker_localisation/core/observation.h"
 #include "picker_localisation/core/picker_registry.h"
@@ -105,6 +106,10 @@ NbsPlannerNode::NbsPlannerNode(ros::NodeHandle& nh, ros::NodeHandle& pnh)
   // The dispatcher's goal for this robot while it serves a call (dispatcher ~goal_topic; "" none).
   if (!o.call_goal_topic.empty())
     call_goal_sub_ = nh_.subscribe(o.call_goal_topic, 5, &NbsPlannerNode::callGoalCallback, this);
+  // The dispatcher's calls: which pickers are about to call (call_due_weight).
+  tray_clock_ = std::make_unique<nbs::TrayClock>(config.call_due_weight, config.tray_time_mean);
+  if (!o.call_status_topic.empty() && config.call_due_weight > 0.0)
+    call_status_sub_ = nh_.subscribe(o.call_status_topic, 5, &NbsPlannerNode::callStatusCallback, this);
   candidates_srv_ = nh_.advertiseService("get_candidates", &NbsPlannerNode::getCandidates, this);
   diagnostics_.setHardwareID(robot_id_);
   diagnostics_.add("nbs_planner", this, &NbsPlannerNode::diagnose);
@@ -231,6 +236,15 @@ void NbsPlannerNode::callGoalCallback(const picker_localisation::GoalNode::Const
   forwardCallGoal(ros::Time::now());
 }
 
+void NbsPlannerNode::callStatusCallback(const picker_localisation::CallStatusArray::ConstPtr& msg) {
+  ++call_status_messages_;
+  for (const picker_localisation::CallStatus& c : msg->calls) {
+    const bool open = c.state != "done" && c.state != "cancelled";
+    const double arrived = c.arrived.isZero() ? std::numeric_limits<double>::quiet_NaN() : c.arrived.toSec();
+    tray_clock_->observeCall(c.picker_id, c.called.toSec(), arrived, open);
+  }
+}
+
 void NbsPlannerNode::forwardCallGoal(const ros::Time& stamp) {
   // The dispatcher's goal is the robot's goal (one goal topic per robot); re-sent each planning period with a
   // fresh stamp, so the other planners keep seeing the claim on the called picker.
@@ -260,6 +274,7 @@ void NbsPlannerNode::planOnce() {
     ROS_WARN("nbs_planner: the clock jumped back: peer goals and the last plan forgotten");
     peer_goals_.clear();
     last_plan_.reset();
+    tray_clock_->reset();
   }
   const ros::Time stamp = ros::Time::now();
   const auto robot = robotNode();
@@ -288,7 +303,11 @@ void NbsPlannerNode::planOnce() {
     if (!node) continue;  // a node the map lost in an edit since the goal came
     goals.push_back({id, *node, g.msg.target_picker});
   }
-  nbs::PlanResult plan = planner_->plan(*robot, battery_level_, pointers, nbs::claimsFor(robot_id_, goals));
+  nbs::PickerWeights weights;  // call-due weights (all 1 with call_due_weight 0)
+  for (const nbs::BeliefSource* p : pointers)
+    weights[p->pickerId()] = tray_clock_->weight(p->pickerId(), stamp.toSec());
+  nbs::PlanResult plan =
+      planner_->plan(*robot, battery_level_, pointers, nbs::claimsFor(robot_id_, goals), weights);
   bool fallback = false;
   for (const auto& s : sources)
     if (s->usedFallback()) {
@@ -416,6 +435,8 @@ void NbsPlannerNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
            call_goal_ ? call_goal_->target_picker + " at " + call_goal_->node : std::string("no"));
   stat.add("call goals", call_goals_);
   stat.add("call goals rejected", call_goals_rejected_);
+  stat.add("call-due weight", tray_clock_->callDueWeight());
+  stat.add("call status messages", call_status_messages_);
   stat.add("belief topic", beliefs_->topic());
   stat.add("beliefs of pickers not listed", beliefs_of_others_);
   std::size_t with_belief = 0;

@@ -32,6 +32,9 @@ struct NbsPlannerNodeOptions {
   std::string battery_topic = "battery";      // BatteryState, robot namespace ("" none)
   std::string goal_pose_topic = "goal_pose";  // the goal as PoseStamped, latched ("" none)
   std::string call_goal_topic = "call_goal";  // the dispatcher's goal while serving a call ("" none)
+  // The dispatcher's calls (CallStatusArray): when each picker's trays were emptied, for the planner's
+  // call-due weights (call_due_weight; "" none: every picker counted from the node's start).
+  std::string call_status_topic = "/dispatcher/status";
   PlannerConfig planner;                      // config/nbs.yaml's planner keys
 
   std::string robotId(const std::string& node_namespace) const;  // robot_id, else the namespace, else robot_1

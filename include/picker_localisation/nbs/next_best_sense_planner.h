@@ -19,7 +19,8 @@
 //                               read_range of c, no read L(n) = 1 - p_detect within read_range and 1
 //                               elsewhere; P_k(read) = p_detect * b_k(read region). w_k = 1, or
 //                               claimed_picker_weight when another robot of higher priority already serves
-//                               picker k.
+//                               picker k, times the picker's call-due weight (TrayClock: pickers whose
+//                               trays are nearly full weigh up to 1 + call_due_weight).
 //  battery [fraction], benefit: expected battery level after driving to c and sensing there (EnergyModel).
 // Candidates are the nodes reachable from r, optionally limited to horizon_hops hops and / or horizon_m
 // metres, minus the goals claimed by higher-priority robots (and nodes within claim_exclusion_hops of them),
@@ -35,6 +36,7 @@
 
 #include "picker_localisation/nbs/belief_source.h"
 #include "picker_localisation/nbs/choquet.h"
+#include "picker_localisation/nbs/tray_clock.h"
 #include "picker_localisation/topology/topological_map.h"
 
 namespace picker_localisation {
@@ -96,6 +98,10 @@ struct PlannerConfig {
   EnergyModel energy;
   double claimed_picker_weight = 0.0;  // w_k of a picker served by a higher-priority robot
   int claim_exclusion_hops = 0;        // nodes within this many hops of a claimed goal are excluded too
+  // Call-aware idle positioning (TrayClock): a picker's w_k is multiplied by
+  // 1 + call_due_weight * min(1, time since its trays were emptied / tray_time_mean). 0: off.
+  double call_due_weight = 0.0;
+  double tray_time_mean = 360.0;  // s, the farm's mean time to fill a picker's trays
   std::string target_picker;  // estimated_node: picker to reach ("" = first unclaimed, in input order)
 
   FuzzyMeasure measure() const;  // throws std::invalid_argument on bad weights / interactions
@@ -145,17 +151,19 @@ class NextBestSensePlanner {
 
   // Ranks the candidate goals of a robot at robot_node with battery_level in [0, 1]. `pickers` are what-if
   // views of the pickers' trackers (non-owning, may be empty: rfid_gain is then 0 everywhere); `claims` are
-  // the goals of the robots with higher priority (see planFleet).
+  // the goals of the robots with higher priority (see planFleet); `picker_weights` multiply the pickers' w_k
+  // (TrayClock::weights; a picker not in it: 1).
   PlanResult plan(topology::NodeIndex robot_node, double battery_level,
-                  const std::vector<BeliefSource*>& pickers, const std::vector<Claim>& claims = {}) const;
+                  const std::vector<BeliefSource*>& pickers, const std::vector<Claim>& claims = {},
+                  const PickerWeights& picker_weights = {}) const;
 
   const PlannerConfig& config() const { return config_; }
   const topology::TopologicalMap& map() const { return *map_; }
 
  private:
   PlanResult planNextBestSense(topology::NodeIndex robot, double battery,
-                               const std::vector<BeliefSource*>& pickers,
-                               const std::vector<Claim>& claims) const;
+                               const std::vector<BeliefSource*>& pickers, const std::vector<Claim>& claims,
+                               const PickerWeights& picker_weights) const;
   PlanResult planEstimatedNode(topology::NodeIndex robot, double battery,
                                const std::vector<BeliefSource*>& pickers,
                                const std::vector<Claim>& claims) const;

@@ -17,6 +17,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <picker_localisation/CallStatusArray.h>
 #include <picker_localisation/GetCandidates.h>
 #include <picker_localisation/GoalNode.h>
 #include <picker_localisation/PickerBelief.h>
@@ -61,6 +62,7 @@ class NbsPlannerNode {
   void applyPickerList(const std::vector<std::string>& ids);
   void peerGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
   void callGoalCallback(const picker_localisation::GoalNode::ConstPtr& msg);
+  void callStatusCallback(const picker_localisation::CallStatusArray::ConstPtr& msg);
   void forwardCallGoal(const ros::Time& stamp);
   void publishGoal(const picker_localisation::GoalNode& goal);  // on goal and goal_pose
   void batteryCallback(const sensor_msgs::BatteryState::ConstPtr& msg);
@@ -92,7 +94,9 @@ class NbsPlannerNode {
   std::vector<ros::Subscriber> peer_subs_;
   std::map<std::string, PeerGoal> peer_goals_;
   StampGuard clock_guard_;  // jump-back detection only
-  ros::Subscriber battery_sub_, call_goal_sub_;
+  ros::Subscriber battery_sub_, call_goal_sub_, call_status_sub_;
+  std::unique_ptr<nbs::TrayClock> tray_clock_;  // the pickers' call-due weights, from the dispatcher's calls
+  std::size_t call_status_messages_ = 0;
   std::optional<picker_localisation::GoalNode> call_goal_;  // the dispatcher's goal while serving a call
   std::size_t call_goals_ = 0, call_goals_rejected_ = 0;
   ros::Publisher goal_pub_, goal_pose_pub_, marker_pub_;
