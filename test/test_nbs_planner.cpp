@@ -213,7 +213,8 @@ TEST(TrayClock, WeightGrowsWithTheTimeSinceTheTraysWereEmptied) {
   EXPECT_DOUBLE_EQ(clock.weight("a", 2110.0), 1.0 + 4.0 * 0.5);  // the trays as they were
   clock.observeCall("a", 1900.0, 1960.0, false);                 // the older call reported again: no change
   EXPECT_DOUBLE_EQ(clock.weight("a", 2110.0), 3.0);
-  const PickerWeights w = clock.weights({"a", "b"}, 2110.0);
+  StaticBeliefSource a("a", {}), b("b", {});
+  const PickerWeights w = clock.weights({&a, &b}, 2110.0);
   ASSERT_EQ(w.size(), 2u);
   EXPECT_DOUBLE_EQ(w.at("b"), 5.0);
   clock.reset();  // the clock jumped back: start again

@@ -702,13 +702,10 @@ void GraphRun::positionIdleRobots(double now) {
   }
   const std::vector<nbs::BeliefSource*> pickers = views();
   // The pickers' call-due weights from the dispatcher's calls, as nbs_planner reads them from its ~status.
-  nbs::PickerWeights weights;
-  if (tray_clock_->callDueWeight() > 0.0) {
+  if (tray_clock_->callDueWeight() > 0.0)
     for (const dispatch::Call& c : dispatcher_->calls())
       tray_clock_->observeCall(c.picker_id, c.stamp, c.arrived_at, c.open());
-    for (const nbs::BeliefSource* p : pickers)
-      weights[p->pickerId()] = tray_clock_->weight(p->pickerId(), now);
-  }
+  const nbs::PickerWeights weights = tray_clock_->weights(pickers, now);
   for (std::size_t r : due) {
     const std::string& id = simulator_.robot(r).id();
     const nbs::PlanResult plan = planner_->plan(simulator_.robot(r).currentNode(), battery_level_, pickers,

@@ -42,9 +42,11 @@ double TrayClock::weight(const std::string& picker_id, double now) {
   const double filled = std::clamp((now - emptied) / tray_time_mean_, 0.0, 1.0);
   return 1.0 + call_due_weight_ * filled;
 }
-PickerWeights TrayClock::weights(const std::vector<std::string>& picker_ids, double now) {
+
+PickerWeights TrayClock::weights(const std::vector<BeliefSource*>& pickers, double now) {
   PickerWeights out;
-  for (const std::string& id : picker_ids) out[id] = weight(id, now);
+  for (const BeliefSource* p : pickers)
+    if (p) out[p->pickerId()] = weight(p->pickerId(), now);
   return out;
 }
 

@@ -303,9 +303,7 @@ void NbsPlannerNode::planOnce() {
     if (!node) continue;  // a node the map lost in an edit since the goal came
     goals.push_back({id, *node, g.msg.target_picker});
   }
-  nbs::PickerWeights weights;  // call-due weights (all 1 with call_due_weight 0)
-  for (const nbs::BeliefSource* p : pointers)
-    weights[p->pickerId()] = tray_clock_->weight(p->pickerId(), stamp.toSec());
+  const nbs::PickerWeights weights = tray_clock_->weights(pointers, stamp.toSec());  // 1 with weight 0
   nbs::PlanResult plan =
       planner_->plan(*robot, battery_level_, pointers, nbs::claimsFor(robot_id_, goals), weights);
   bool fallback = false;

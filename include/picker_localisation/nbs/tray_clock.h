@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "picker_localisation/nbs/belief_source.h"
+
 namespace picker_localisation {
 namespace nbs {
 
@@ -36,7 +38,8 @@ class TrayClock {
   // 1 + call_due_weight (a call cancelled before any robot came leaves the trays as they were). Call-due
   // weight 0: 1 for every picker.
   double weight(const std::string& picker_id, double now);
-  PickerWeights weights(const std::vector<std::string>& picker_ids, double now);
+  // weight() of each picker the planner is given (the runner and the node alike).
+  PickerWeights weights(const std::vector<BeliefSource*>& pickers, double now);
 
   double callDueWeight() const { return call_due_weight_; }
 
