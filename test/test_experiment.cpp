@@ -319,8 +319,17 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     std::stringstream cs(line);
     std::string cell;
     while (std::getline(cs, cell, ',')) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 16u) << line;
-    const double true_lane = std::stod(cells[11]), top = std::stod(cells[12]), age = std::stod(cells[13]);
+    ASSERT_EQ(cells.size(), 17u) << line;
+    // The evidence that declared an arrival: the person's association probability, or a read at least as
+    // strong as the dispatcher's arrival_min_rssi (-48 dBm).
+    if (cells[8] == "lidar") {
+      EXPECT_GE(std::stod(cells[9]), 0.0) << line;
+      EXPECT_LE(std::stod(cells[9]), 1.0) << line;
+    } else if (cells[8] == "rfid") {
+      EXPECT_GE(std::stod(cells[9]), -48.0) << line;
+      EXPECT_LT(std::stod(cells[9]), 0.0) << line;
+    }
+    const double true_lane = std::stod(cells[12]), top = std::stod(cells[13]), age = std::stod(cells[14]);
     if (std::isnan(top)) continue;  // never assigned
     ++assigned;
     EXPECT_GE(top, 0.0);
@@ -328,7 +337,7 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     if (!std::isnan(true_lane)) EXPECT_LE(true_lane, top + 1e-9) << line;
     if (true_lane > 0.5) ++mostly_right;
     EXPECT_GE(age, 0.0) << line;
-    const double residual = std::stod(cells[14]);
+    const double residual = std::stod(cells[15]);
     if (!std::isnan(residual)) EXPECT_GE(residual, 0.0) << line;
   }
   EXPECT_GE(assigned, 5u);

@@ -294,7 +294,8 @@ class GraphRun {
   void recordCallPicker(OpenCall& c, double now);
   void publish(const core::Observation& obs);
   NodeIndex estimate(std::size_t picker) const;
-  void arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by);  // scoring an arrival
+  // Scoring an arrival; `evidence`: the person's association probability (lidar) or the read's RSSI (rfid).
+  void arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by, double evidence);
   // The calls scenario at the end of a step: beliefs and robot nodes to the dispatcher, its goals to the
   // robots, loaded pickers released, each open call scored.
   void dispatchCalls(double now);
@@ -469,7 +470,7 @@ void GraphRun::onRfid(const sim::RfidReadingWithTruth& rr) {
     if (dispatcher_ && r.observation->identifying) {
       const dispatch::Call* served = dispatcher_->servedBy(robot_id);
       if (served && dispatcher_->rfidRead(robot_id, r.observation->picker_id, rr.stamp, rr.rssi))
-        arrived(served->id, rr.robot_index, rr.stamp, "rfid");
+        arrived(served->id, rr.robot_index, rr.stamp, "rfid", rr.rssi);
     }
   }
   for (const auto& neg : r.negative) publish(neg);
@@ -499,7 +500,7 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
       const dispatch::Call* served = dispatcher_->servedBy(s.robot_id);
       const double d = (t.position - simulator_.robotPose(s.robot_index).position()).norm();
       if (served && dispatcher_->lidarPerson(s.robot_id, a.observation.picker_id, s.stamp, d))
-        arrived(served->id, s.robot_index, s.stamp, "lidar");
+        arrived(served->id, s.robot_index, s.stamp, "lidar", a.probabilities[a.picker]);
     }
     if (a.picker >= 0) {
       ++result_.identified_detections;
@@ -531,7 +532,8 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
   if (!people.empty()) ukf_.addDetections(s.stamp, people);
 }
 
-void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by) {
+void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp, const char* by,
+                       double evidence) {
   OpenCall& c = open_calls_.at(call_id);
   c.arrived = true;
   c.record.arrival_s =
@@ -540,6 +542,7 @@ void GraphRun::arrived(std::uint64_t call_id, std::size_t robot, double stamp, c
       (simulator_.robotPose(robot).position() - simulator_.pickerPose(c.picker).position()).norm();
   c.record.false_arrival = c.record.arrival_distance > 3.0;
   c.record.arrived_by = by;
+  c.record.arrival_evidence = evidence;
 }
 
 void GraphRun::onCall(const sim::PickerCall& call) {
@@ -962,16 +965,16 @@ std::vector<RunResult> runSeeds(const std::shared_ptr<const topology::Topologica
 void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::ofstream calls(dir / ("calls_" + std::to_string(k) + ".csv"));
-    calls
-        << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
-           "lane,false_arrival,arrival_distance,arrived_by,metres,reported_row,true_lane_mass,top_lane_mass,"
-           "sighting_age_s,bias_residual_m,wrong_identities_600s\n";
+    calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
+             "lane,false_arrival,arrival_distance,arrived_by,arrival_evidence,metres,reported_row,true_lane_"
+             "mass,top_lane_mass,"
+             "sighting_age_s,bias_residual_m,wrong_identities_600s\n";
     for (const CallRecord& c : runs[k].calls)
       calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
             << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
-            << c.arrival_distance << "," << c.arrived_by << "," << c.metres << "," << c.reported_row << ","
-            << c.true_lane_mass << "," << c.top_lane_mass << "," << c.sighting_age_s << ","
-            << c.bias_residual_m << "," << c.wrong_identities_600s << "\n";
+            << c.arrival_distance << "," << c.arrived_by << "," << c.arrival_evidence << "," << c.metres
+            << "," << c.reported_row << "," << c.true_lane_mass << "," << c.top_lane_mass << ","
+            << c.sighting_age_s << "," << c.bias_residual_m << "," << c.wrong_identities_600s << "\n";
   }
 }
 

@@ -103,6 +103,9 @@ struct CallRecord {
   bool false_arrival = false;          // arrival declared with the picker more than 3 m from the robot
   double arrival_distance = 0.0;       // m, robot to picker when the arrival was declared (truth)
   std::string arrived_by;              // "rfid" or "lidar": the sensing that declared the arrival
+  // The evidence that declared it: for "lidar" the association probability the person was named at, for
+  // "rfid" the read's RSSI in dBm.
+  double arrival_evidence = std::nan("");
   double metres = 0.0;                 // driven by the serving robot from assignment to arrival
   bool reported_row = false;           // the call carried a reported row
   // What the picker's belief and bias estimate were when a robot was assigned (the farm's tracker, whatever
