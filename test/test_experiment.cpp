@@ -310,7 +310,8 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
   std::ifstream calls(dir / "oracle" / "calls_0.csv");
   std::string header;
   std::getline(calls, header);
-  ASSERT_NE(header.find(",true_lane_mass,top_lane_mass,sighting_age_s,bias_residual_m,wrong_identities_600s"),
+  ASSERT_NE(header.find(",true_lane_mass,top_lane_mass,sighting_age_s,last_sighting_error_m,bias_residual_m,"
+                        "wrong_identities_600s"),
             std::string::npos)
       << header;
   std::size_t assigned = 0, mostly_right = 0;
@@ -319,7 +320,7 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     std::stringstream cs(line);
     std::string cell;
     while (std::getline(cs, cell, ',')) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 17u) << line;
+    ASSERT_EQ(cells.size(), 18u) << line;
     // The evidence that declared an arrival: the person's association probability, or a read at least as
     // strong as the dispatcher's arrival_min_rssi (-48 dBm).
     if (cells[8] == "lidar") {
@@ -334,11 +335,19 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     ++assigned;
     EXPECT_GE(top, 0.0);
     EXPECT_LE(top, 1.0 + 1e-9);
-    if (!std::isnan(true_lane)) EXPECT_LE(true_lane, top + 1e-9) << line;
+    if (!std::isnan(true_lane)) {
+      EXPECT_LE(true_lane, top + 1e-9) << line;
+    }
     if (true_lane > 0.5) ++mostly_right;
     EXPECT_GE(age, 0.0) << line;
-    const double residual = std::stod(cells[15]);
-    if (!std::isnan(residual)) EXPECT_GE(residual, 0.0) << line;
+    const double sighting_error = std::stod(cells[15]);  // NaN: the last sighting was a tag read, or none
+    if (!std::isnan(sighting_error)) {
+      EXPECT_GE(sighting_error, 0.0) << line;
+    }
+    const double residual = std::stod(cells[16]);
+    if (!std::isnan(residual)) {
+      EXPECT_GE(residual, 0.0) << line;
+    }
   }
   EXPECT_GE(assigned, 5u);
   EXPECT_GT(mostly_right * 2, assigned);

@@ -279,6 +279,9 @@ class GraphRun {
     // "Lane right within 30 s of a sighting after the first fix or a blackout".
     double restart = std::nan("");             // stamp of the first fix, or of the fix that ended a blackout
     double seen_after_restart = std::nan("");  // first accepted bias sighting after it
+    // The latest accepted LiDAR bias sighting: its stamp, and how far the person was from this picker then.
+    double lidar_sighting_stamp = std::nan("");
+    double lidar_sighting_error = std::nan("");
   };
   // A call the dispatcher serves, scored from the simulator's truth.
   struct OpenCall {
@@ -519,6 +522,9 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
     if (a.bias.accepted) {
       ++result_.bias_sightings;
       Scoring& seen = scoring_[static_cast<std::size_t>(a.picker)];
+      seen.lidar_sighting_stamp = s.stamp;
+      seen.lidar_sighting_error =
+          (simulator_.pickerPose(static_cast<std::size_t>(a.picker)).position() - t.position).norm();
       if (!std::isnan(seen.restart) && std::isnan(seen.seen_after_restart)) seen.seen_after_restart = s.stamp;
     }
     if (a.concerns_nobody) continue;  // nobody we track (clutter under the association)
@@ -650,6 +656,10 @@ void GraphRun::recordCallPicker(OpenCall& c, double now) {
   // The sighting may carry the step's own stamp, a rounding above `now`.
   r.sighting_age_s =
       bias.sighted() ? std::max(0.0, now - bias.lastSighting()) : std::numeric_limits<double>::infinity();
+  // The last accepted sighting was this LiDAR person (not a tag read since): how far from the picker it was.
+  const Scoring& seen = scoring_[c.picker];
+  if (bias.sighted() && seen.lidar_sighting_stamp == bias.lastSighting())
+    r.last_sighting_error_m = seen.lidar_sighting_error;
   const Eigen::Vector2d& error = scoring_[c.picker].true_gnss_error;
   if (error.allFinite()) r.bias_residual_m = (error - bias.applied(now)).norm();
   const std::vector<double>& wrong = wrong_identity_stamps_[c.picker];
@@ -968,13 +978,14 @@ void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
     calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
              "lane,false_arrival,arrival_distance,arrived_by,arrival_evidence,metres,reported_row,true_lane_"
              "mass,top_lane_mass,"
-             "sighting_age_s,bias_residual_m,wrong_identities_600s\n";
+             "sighting_age_s,last_sighting_error_m,bias_residual_m,wrong_identities_600s\n";
     for (const CallRecord& c : runs[k].calls)
       calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
             << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
             << c.arrival_distance << "," << c.arrived_by << "," << c.arrival_evidence << "," << c.metres
             << "," << c.reported_row << "," << c.true_lane_mass << "," << c.top_lane_mass << ","
-            << c.sighting_age_s << "," << c.bias_residual_m << "," << c.wrong_identities_600s << "\n";
+            << c.sighting_age_s << "," << c.last_sighting_error_m << "," << c.bias_residual_m << ","
+            << c.wrong_identities_600s << "\n";
   }
 }
 

@@ -113,6 +113,9 @@ struct CallRecord {
   double true_lane_mass = std::nan("");   // the belief's mass in the picker's true lane (NaN: not in a lane)
   double top_lane_mass = std::nan("");    // the largest mass of any one lane
   double sighting_age_s = std::nan("");   // s since the picker's last accepted bias sighting (+inf: never)
+  // m from the picker to the LiDAR person of that sighting, when it was one (NaN: a tag read, or none): a
+  // sighting of someone else teaches the bias of a wrong place.
+  double last_sighting_error_m = std::nan("");
   double bias_residual_m = std::nan("");  // m, |the unit's true error - the bias estimate applied|
   std::size_t wrong_identities_600s = 0;  // LiDAR people given to or taken from this picker wrongly in the
                                           // 600 s before the call (scoring only)
