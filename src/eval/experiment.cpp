@@ -660,7 +660,7 @@ void GraphRun::recordCallPicker(OpenCall& c, double now) {
   const Scoring& seen = scoring_[c.picker];
   if (bias.sighted() && seen.lidar_sighting_stamp == bias.lastSighting())
     r.last_sighting_error_m = seen.lidar_sighting_error;
-  const Eigen::Vector2d& error = scoring_[c.picker].true_gnss_error;
+  const Eigen::Vector2d& error = seen.true_gnss_error;
   if (error.allFinite()) r.bias_residual_m = (error - bias.applied(now)).norm();
   const std::vector<double>& wrong = wrong_identity_stamps_[c.picker];
   r.wrong_identities_600s = static_cast<std::size_t>(
@@ -975,10 +975,10 @@ std::vector<RunResult> runSeeds(const std::shared_ptr<const topology::Topologica
 void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::ofstream calls(dir / ("calls_" + std::to_string(k) + ".csv"));
-    calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_"
-             "lane,false_arrival,arrival_distance,arrived_by,arrival_evidence,metres,reported_row,true_lane_"
-             "mass,top_lane_mass,"
-             "sighting_age_s,last_sighting_error_m,bias_residual_m,wrong_identities_600s\n";
+    calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_lane,"
+             "false_arrival,arrival_distance,arrived_by,arrival_evidence,metres,reported_row,"
+             "true_lane_mass,top_lane_mass,sighting_age_s,last_sighting_error_m,bias_residual_m,"
+             "wrong_identities_600s\n";
     for (const CallRecord& c : runs[k].calls)
       calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
             << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
