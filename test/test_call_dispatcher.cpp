@@ -213,6 +213,8 @@ TEST(CallDispatcher, WithACommitShareTheRobotWaitsAtTheLaneEndUntilTheBeliefComm
   goals = d.update(20.0);
   ASSERT_EQ(goals.size(), 1u);
   EXPECT_EQ(goals[0].node, node(*map, "r5_6"));
+  EXPECT_DOUBLE_EQ(d.find(id)->holding_since, 10.0);  // the robot held at the lane end from 10 s to 20 s
+  EXPECT_DOUBLE_EQ(d.find(id)->hold_ended, 20.0);
   // Uncommitted again, but the robot waited commit_wait at the lane end: it enters the likelier lane.
   d.setBelief("picker_1", {node(*map, "r4_6"), node(*map, "r5_6")}, {0.6, 0.4});
   goals = d.update(25.0);
@@ -231,6 +233,9 @@ TEST(CallDispatcher, AnIdentifiedLidarPersonNearTheRobotIsArrival) {
   const auto id = *d.call("picker_1", 0.0);
   d.update(0.0);
   EXPECT_FALSE(d.lidarPerson("robot_1", "picker_1", 6.0, 1.6));  // beyond arrival_distance (1.5 m)
+  // Near, but named less surely than arrival_min_probability: not arrival.
+  EXPECT_FALSE(d.lidarPerson("robot_1", "picker_1", 6.5, 1.0, options().arrival_min_probability - 0.01));
+  EXPECT_NE(d.find(id)->state, CallState::kArrived);
   EXPECT_TRUE(d.lidarPerson("robot_1", "picker_1", 7.0, 1.4));
   EXPECT_EQ(d.find(id)->state, CallState::kArrived);
 }

@@ -311,8 +311,11 @@ TEST(DispatcherNode, AnswersCallsAndRefusesBadOnes) {
     for (std::size_t k = 0; k < o.nodes.size(); ++k) {
       const bool in_row = g_map->lane(*g_map->index(o.nodes[k])) == g_map->lane(p3);
       EXPECT_GT(o.likelihood[k], 0.0);
-      if (in_row) EXPECT_DOUBLE_EQ(o.likelihood[k], 1.0);
-      if (!in_row) EXPECT_LT(o.likelihood[k], 1.0);
+      if (in_row) {
+        EXPECT_DOUBLE_EQ(o.likelihood[k], 1.0);
+      } else {
+        EXPECT_LT(o.likelihood[k], 1.0);
+      }
     }
     EXPECT_EQ(openCallOf("picker_2")->row, row);
   }
@@ -345,7 +348,9 @@ TEST(DispatcherNode, AnswersCallsAndRefusesBadOnes) {
   for (const auto& c : all.response.calls) {
     const bool closed = c.state == "done" || c.state == "cancelled";
     ASSERT_EQ(logged.count(c.call_id), closed ? 1u : 0u) << "call " << c.call_id << " " << c.state;
-    if (closed) EXPECT_EQ(logged.at(c.call_id), c.state);
+    if (closed) {
+      EXPECT_EQ(logged.at(c.call_id), c.state);
+    }
   }
   std::remove(log_file.c_str());
   std::lock_guard<std::mutex> lock(g_mutex);

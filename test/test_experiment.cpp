@@ -311,7 +311,7 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
   std::string header;
   std::getline(calls, header);
   ASSERT_NE(header.find(",true_lane_mass,top_lane_mass,sighting_age_s,last_sighting_error_m,bias_residual_m,"
-                        "wrong_identities_600s"),
+                        "wrong_identities_600s,queued_s,held_s"),
             std::string::npos)
       << header;
   std::size_t assigned = 0, mostly_right = 0;
@@ -320,7 +320,7 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     std::stringstream cs(line);
     std::string cell;
     while (std::getline(cs, cell, ',')) cells.push_back(cell);
-    ASSERT_EQ(cells.size(), 18u) << line;
+    ASSERT_EQ(cells.size(), 20u) << line;
     // The evidence that declared an arrival: the person's association probability, or a read at least as
     // strong as the dispatcher's arrival_min_rssi (-48 dBm).
     if (cells[8] == "lidar") {
@@ -348,6 +348,8 @@ TEST(Experiment, CallsScenarioScoresEveryCall) {
     if (!std::isnan(residual)) {
       EXPECT_GE(residual, 0.0) << line;
     }
+    EXPECT_GE(std::stod(cells[18]), 0.0) << line;  // queued until assigned
+    EXPECT_EQ(std::stod(cells[19]), 0.0) << line;  // the oracle's one node is one lane: never held at its end
   }
   EXPECT_GE(assigned, 5u);
   EXPECT_GT(mostly_right * 2, assigned);

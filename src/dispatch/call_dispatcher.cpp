@@ -42,6 +42,8 @@ std::string DispatcherOptions::validate() const {
     return core::badValue("arrival_distance", arrival_distance, "> 0");
   if (!(load_time >= 0.0) || !std::isfinite(load_time)) return core::badValue("load_time", load_time, ">= 0");
   if (!std::isfinite(arrival_min_rssi)) return core::badValue("arrival_min_rssi", arrival_min_rssi, "finite");
+  if (!(arrival_min_probability >= 0.0 && arrival_min_probability <= 1.0))
+    return core::badValue("arrival_min_probability", arrival_min_probability, "in [0, 1]");
   if (!(commit_share >= 0.0 && commit_share <= 1.0))
     return core::badValue("commit_share", commit_share, "in [0, 1]");
   if (!(commit_wait >= 0.0) || !std::isfinite(commit_wait))
@@ -50,9 +52,9 @@ std::string DispatcherOptions::validate() const {
 }
 
 const std::vector<std::string>& DispatcherOptions::yamlKeys() {
-  static const std::vector<std::string> keys = {"robot_speed",      "arrival_distance", "load_time",
-                                                "arrival_min_rssi", "commit_share",     "commit_wait",
-                                                "storage_node",     "arrival_by_lidar"};
+  static const std::vector<std::string> keys = {
+      "robot_speed", "arrival_distance", "load_time",        "arrival_min_rssi",       "commit_share",
+      "commit_wait", "storage_node",     "arrival_by_lidar", "arrival_min_probability"};
   return keys;
 }
 
@@ -65,6 +67,7 @@ DispatcherOptions DispatcherOptions::fromYaml(const YAML::Node& node, std::vecto
   core::readOption(node, c, "arrival_min_rssi", o.arrival_min_rssi);
   core::readOption(node, c, "commit_share", o.commit_share);
   core::readOption(node, c, "arrival_by_lidar", o.arrival_by_lidar);
+  core::readOption(node, c, "arrival_min_probability", o.arrival_min_probability);
   core::readOption(node, c, "commit_wait", o.commit_wait);
   core::readOption(node, c, "storage_node", o.storage_node);
   return core::checkOptions(o, node, yamlKeys(), c, unknown);
@@ -207,8 +210,9 @@ bool CallDispatcher::sighting(const std::string& robot_id, const std::string& pi
 }
 
 bool CallDispatcher::lidarPerson(const std::string& robot_id, const std::string& picker_id, double stamp,
-                                 double distance) {
-  return options_.arrival_by_lidar && sighting(robot_id, picker_id, stamp, distance);
+                                 double distance, double probability) {
+  return options_.arrival_by_lidar && probability >= options_.arrival_min_probability &&
+         sighting(robot_id, picker_id, stamp, distance);
 }
 
 bool CallDispatcher::rfidRead(const std::string& robot_id, const std::string& picker_id, double stamp,
@@ -262,8 +266,10 @@ NodeIndex CallDispatcher::goalFor(Call& c, double now) const {
   const bool in_target_lane =
       robot != robot_node_.end() && map_->lane(robot->second) == lane && !laneEnd(robot->second);
   if (lane_mass[lane] >= options_.commit_share || in_target_lane ||
-      (!std::isnan(c.holding_since) && now - c.holding_since >= options_.commit_wait))
+      (!std::isnan(c.holding_since) && now - c.holding_since >= options_.commit_wait)) {
+    if (!std::isnan(c.holding_since) && std::isnan(c.hold_ended)) c.hold_ended = now;
     return t;
+  }
   // Not committed: the end of a lane carrying mass with the least expected path to the picker.
   NodeIndex best = t;
   double best_cost = std::numeric_limits<double>::infinity();

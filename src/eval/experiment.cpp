@@ -267,7 +267,7 @@ class GraphRun {
   // One error sample per picker with an estimate (scoring).
   void sample(double t);
   // The calls scenario's calls still open at the end of the run: scored as not arrived.
-  void finish();
+  void finish(double now);  // the run ended at now: open calls are scored as they stand
   RunResult& result() { return result_; }
 
  private:
@@ -295,6 +295,8 @@ class GraphRun {
   };
   // Scoring: the belief and bias estimate of a call's picker when its robot is assigned.
   void recordCallPicker(OpenCall& c, double now);
+  // How long the call waited for a robot and how long that robot waited at a lane end (scoring).
+  void recordWaits(CallRecord& r, const dispatch::Call& call, double now);
   void publish(const core::Observation& obs);
   NodeIndex estimate(std::size_t picker) const;
   // Scoring an arrival; `evidence`: the person's association probability (lidar) or the read's RSSI (rfid).
@@ -502,7 +504,8 @@ void GraphRun::onScan(const sim::LaserScanWithTruth& s) {
     if (a.picker >= 0 && dispatcher_) {  // the serving robot's own identified person: arrival when near
       const dispatch::Call* served = dispatcher_->servedBy(s.robot_id);
       const double d = (t.position - simulator_.robotPose(s.robot_index).position()).norm();
-      if (served && dispatcher_->lidarPerson(s.robot_id, a.observation.picker_id, s.stamp, d))
+      if (served && dispatcher_->lidarPerson(s.robot_id, a.observation.picker_id, s.stamp, d,
+                                             a.probabilities[a.picker]))
         arrived(served->id, s.robot_index, s.stamp, "lidar", a.probabilities[a.picker]);
     }
     if (a.picker >= 0) {
@@ -632,6 +635,7 @@ void GraphRun::dispatchCalls(double now) {
       c.released = true;
     }
     if (!call.open()) {
+      recordWaits(c.record, call, now);
       result_.calls.push_back(c.record);
       it = open_calls_.erase(it);
     } else {
@@ -667,8 +671,21 @@ void GraphRun::recordCallPicker(OpenCall& c, double now) {
       std::count_if(wrong.begin(), wrong.end(), [&](double t) { return t <= now && t > now - 600.0; }));
 }
 
-void GraphRun::finish() {
-  for (const auto& [id, c] : open_calls_) result_.calls.push_back(c.record);
+void GraphRun::recordWaits(CallRecord& r, const dispatch::Call& call, double now) {
+  r.queued_s =
+      std::isnan(call.assigned_at) ? std::numeric_limits<double>::infinity() : call.assigned_at - call.stamp;
+  if (std::isnan(call.holding_since)) return;
+  const double end = !std::isnan(call.hold_ended)   ? call.hold_ended
+                     : !std::isnan(call.arrived_at) ? call.arrived_at
+                                                    : now;
+  r.held_s = end - call.holding_since;
+}
+
+void GraphRun::finish(double now) {
+  for (auto& [id, c] : open_calls_) {
+    recordWaits(c.record, *dispatcher_->find(id), now);
+    result_.calls.push_back(c.record);
+  }
   open_calls_.clear();
 }
 
@@ -818,7 +835,7 @@ RunResult runOnce(std::shared_ptr<const topology::TopologicalMap> map, const Run
     for (; next_sample <= simulator.time() + 1e-9; next_sample += config.sample_period)
       run.sample(next_sample);
   }
-  run.finish();
+  run.finish(simulator.time());
   RunResult result = std::move(run.result());
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return result;
@@ -978,14 +995,14 @@ void writeCallFiles(const fs::path& dir, const std::vector<RunResult>& runs) {
     calls << "picker_id,stamp,arrival_s,wrong_lane_entries,through_lane_entries,first_target_in_picker_lane,"
              "false_arrival,arrival_distance,arrived_by,arrival_evidence,metres,reported_row,"
              "true_lane_mass,top_lane_mass,sighting_age_s,last_sighting_error_m,bias_residual_m,"
-             "wrong_identities_600s\n";
+             "wrong_identities_600s,queued_s,held_s\n";
     for (const CallRecord& c : runs[k].calls)
       calls << c.picker_id << "," << c.stamp << "," << c.arrival_s << "," << c.wrong_lane_entries << ","
             << c.through_lane_entries << "," << c.first_target_in_picker_lane << "," << c.false_arrival << ","
             << c.arrival_distance << "," << c.arrived_by << "," << c.arrival_evidence << "," << c.metres
             << "," << c.reported_row << "," << c.true_lane_mass << "," << c.top_lane_mass << ","
             << c.sighting_age_s << "," << c.last_sighting_error_m << "," << c.bias_residual_m << ","
-            << c.wrong_identities_600s << "\n";
+            << c.wrong_identities_600s << "," << c.queued_s << "," << c.held_s << "\n";
   }
 }
 

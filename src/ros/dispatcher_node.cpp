@@ -304,7 +304,11 @@ void DispatcherNode::observationCallback(const picker_localisation::Observation:
   const auto robot = robotPosition(msg->robot_id);
   if (!robot) return;
   const double d = (Eigen::Vector2d(msg->position.x, msg->position.y) - *robot).norm();
-  if (dispatcher_->lidarPerson(msg->robot_id, msg->picker_id, msg->header.stamp.toSec(), d)) {
+  // The probability the association named the person at (none given: a sure identity).
+  double probability = 1.0;
+  for (std::size_t k = 0; k < msg->candidate_pickers.size() && k < msg->candidate_probabilities.size(); ++k)
+    if (msg->candidate_pickers[k] == msg->picker_id) probability = msg->candidate_probabilities[k];
+  if (dispatcher_->lidarPerson(msg->robot_id, msg->picker_id, msg->header.stamp.toSec(), d, probability)) {
     ++arrivals_;
     ROS_INFO("%s: %s sees %s %.1f m away (%s): arrived", ros::this_node::getName().c_str(),
              msg->robot_id.c_str(), msg->picker_id.c_str(), d, msg->sensor.c_str());

@@ -107,6 +107,8 @@ struct CallRecord {
   // "rfid" the read's RSSI in dBm.
   double arrival_evidence = std::nan("");
   double metres = 0.0;                 // driven by the serving robot from assignment to arrival
+  double queued_s = 0.0;               // s from the call until a robot was assigned (+inf: never)
+  double held_s = 0.0;  // s the serving robot waited at a lane end for the belief to commit to a lane
   bool reported_row = false;           // the call carried a reported row
   // What the picker's belief and bias estimate were when a robot was assigned (the farm's tracker, whatever
   // the method tells the dispatcher): where wrong-lane entries come from.
